@@ -254,12 +254,14 @@ def build_tree(p: RobotParams) -> KinematicTree:
         frames += arm_frames
         frames.append(Frame(f"{side}_sole", f"{side}_foot", (0.0, 0.0, -p.ankle_to_sole_m)))
     neck = (0.0, 0.0, p.neck_above_torso_m)
+    neck_motor_kg = 0.05  # each of the two neck motor links; the rest of the head mass is the head
     links += [
-        _limb("neck_yaw", "torso", "NKY", (0, 0, 1), neck, 0.05, 0.0, 0.03, p),
-        _limb("neck_pitch", "neck_yaw", "NK1", (0, 1, 0), (0, 0, 0), 0.05, 0.0, 0.03, p),
+        _limb("neck_yaw", "torso", "NKY", (0, 0, 1), neck, neck_motor_kg, 0.0, 0.03, p),
+        _limb("neck_pitch", "neck_yaw", "NK1", (0, 1, 0), (0, 0, 0), neck_motor_kg, 0.0, 0.03, p),
     ]
-    head = Link("head", "neck_pitch", "NK2", (1, 0, 0), (0, 0, 0), p.mass_head_kg,
-                (0.0, 0.0, 0.08), _box_inertia(p.mass_head_kg, (0.08, 0.08, 0.08)),
+    head_kg = p.mass_head_kg - 2 * neck_motor_kg
+    head = Link("head", "neck_pitch", "NK2", (1, 0, 0), (0, 0, 0), head_kg,
+                (0.0, 0.0, 0.08), _box_inertia(head_kg, (0.08, 0.08, 0.08)),
                 (Geom("sphere", (0.0, 0.0, 0.08), radius=0.09),), *_limits(p, "NK2"),
                 _torque(p, "NK2"), _speed_max(p, "NK2"), _armature(p, "NK2"))
     links.append(head)

@@ -1,0 +1,91 @@
+"""Holds and stances: which limb touches what, through which point contacts (thesis §6.3.1).
+
+A foot hold is the part of the sole resting on a rung: the sole corners clipped to the
+rung's tread, each a point contact pushing up. A hand hold is a palm closed on a rail:
+one contact that pushes up (the hand can lean down on the rail) and one that pulls the
+hand towards the ladder (the fingers pull back). All contacts carry Coulomb friction μ.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+LIMBS = ("left_hand", "right_hand", "left_foot", "right_foot")
+#: Operational frame of each limb in the robot model.
+LIMB_FRAME = {"left_hand": "L_palm", "right_hand": "R_palm", "left_foot": "L_sole",
+              "right_foot": "R_sole"}
+
+
+@dataclass(frozen=True)
+class Hold:
+    """One limb's contact with the environment.
+
+    Attributes:
+        limb: one of ``LIMBS``.
+        target: what is held, e.g. ``"floor"``, ``"rung 3"``, ``"rail left"``.
+        T_world_frame: (4, 4) pose the limb's frame must take [m].
+        points_m: (k, 3) contact points in the world frame [m].
+        normals: (k, 3) unit contact normals (force on the robot pushes along them).
+        friction: Coulomb coefficient μ of every contact.
+    """
+
+    limb: str
+    target: str
+    T_world_frame: np.ndarray = field(repr=False)
+    points_m: np.ndarray = field(repr=False)
+    normals: np.ndarray = field(repr=False)
+    friction: float = 0.4
+
+    @property
+    def frame(self) -> str:
+        return LIMB_FRAME[self.limb]
+
+    @property
+    def is_hand(self) -> bool:
+        return self.limb.endswith("hand")
+
+    def __repr__(self) -> str:
+        p = self.T_world_frame[:3, 3]
+        return f"Hold({self.limb} on {self.target} at [{p[0]:.3f}, {p[1]:.3f}, {p[2]:.3f}])"
+
+
+@dataclass(frozen=True)
+class Stance:
+    """A set of 2–4 holds, at most one per limb."""
+
+    holds: tuple[Hold, ...]
+
+    def __post_init__(self) -> None:
+        limbs = [h.limb for h in self.holds]
+        if len(set(limbs)) != len(limbs):
+            raise ValueError(f"a stance holds each limb at most once, got {limbs}")
+        if not 1 <= len(limbs) <= 4:
+            raise ValueError(f"a stance has 1–4 holds, got {len(limbs)}")
+
+    def hold(self, limb: str) -> Hold | None:
+        for h in self.holds:
+            if h.limb == limb:
+                return h
+        return None
+
+    @property
+    def limbs(self) -> tuple[str, ...]:
+        return tuple(h.limb for h in self.holds)
+
+    def points_normals(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """All contact points (n,3), normals (n,3) and friction coefficients (n,)."""
+        pts = np.vstack([h.points_m for h in self.holds])
+        nrm = np.vstack([h.normals for h in self.holds])
+        mu = np.concatenate([np.full(len(h.points_m), h.friction) for h in self.holds])
+        return pts, nrm, mu
+
+    def without(self, limb: str) -> Stance:
+        return Stance(tuple(h for h in self.holds if h.limb != limb))
+
+    def with_hold(self, hold: Hold) -> Stance:
+        return Stance(tuple(h for h in self.holds if h.limb != hold.limb) + (hold,))
+
+    def __repr__(self) -> str:
+        return "Stance(" + ", ".join(f"{h.limb}@{h.target}" for h in self.holds) + ")"

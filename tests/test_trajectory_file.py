@@ -1,0 +1,115 @@
+"""40-column trajectory files: exact round trip, and every malformation refused with its line."""
+
+import numpy as np
+import pytest
+
+from robot.errors import TrajectoryFileError
+from robot.joints import JOINT_NAMES
+from robot.limits import joint_limits
+from robot.trajectory_file import format_trajectory, read_trajectory, write_trajectory
+
+
+def _smooth_trajectory(n=50, seed=3):
+    rng = np.random.default_rng(seed)
+    lim = joint_limits("drc-hubo")
+    lo, hi = np.maximum(lim.lower_rad, -1.0), np.minimum(lim.upper_rad, 1.0)
+    a, b = rng.uniform(lo, hi), rng.uniform(lo, hi)
+    s = np.linspace(0, 1, n)[:, None]
+    return a + (b - a) * s  # at most 2 rad over 49 steps at 25 Hz ≈ 1 rad/s
+
+
+def _write_lines(tmp_path, lines):
+    path = tmp_path / "bad.traj"
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def _fail(path, rate=25.0):
+    with pytest.raises(TrajectoryFileError) as err:
+        read_trajectory(path, rate)
+    return str(err.value)
+
+
+def test_round_trip_is_exact(tmp_path):
+    q = _smooth_trajectory()
+    q[3, 5] += 1 / 3000  # a value with no short decimal form
+    path = tmp_path / "climb.traj"
+    write_trajectory(path, q)
+    back = read_trajectory(path, 25.0)
+    assert back.shape == (50, 40)
+    assert np.array_equal(back, q)  # bit for bit
+
+
+def test_written_lines_are_what_the_original_player_reads(tmp_path):
+    text = format_trajectory(_smooth_trajectory(5))
+    lines = text.split("\n")
+    assert lines[-1] == "" and len(lines) == 6
+    for line in lines[:-1]:
+        assert len(line) < 999  # fgets(buf, 1000)
+        assert len(line.split(" ")) == 40
+
+
+def test_short_line_is_refused_with_its_line(tmp_path):
+    q = _smooth_trajectory(5)
+    lines = format_trajectory(q).splitlines()
+    lines[2] = " ".join(lines[2].split()[:31])  # real files with 31 columns exist
+    msg = _fail(_write_lines(tmp_path, lines))
+    assert "bad.traj:3:" in msg and "31 columns; expected 40" in msg
+
+
+def test_header_line_is_refused(tmp_path):
+    lines = [" ".join(JOINT_NAMES)] + format_trajectory(_smooth_trajectory(3)).splitlines()
+    msg = _fail(_write_lines(tmp_path, lines))
+    assert "bad.traj:1:1: column 1 (RHY): 'RHY' is not a number" in msg
+    assert "header" in msg
+
+
+@pytest.mark.parametrize("token", ["nan", "inf", "-inf", "NaN"])
+def test_non_finite_values_are_refused(tmp_path, token):
+    lines = format_trajectory(_smooth_trajectory(4)).splitlines()
+    cols = lines[1].split()
+    cols[7] = token
+    lines[1] = " ".join(cols)
+    msg = _fail(_write_lines(tmp_path, lines))
+    assert "bad.traj:2:" in msg and "column 8 (LHR)" in msg and "not finite" in msg
+
+
+def test_overlong_line_is_refused(tmp_path):
+    lines = format_trajectory(_smooth_trajectory(3)).splitlines()
+    lines[1] = lines[1] + " " + "0.0" * 400  # the original split this line in two
+    msg = _fail(_write_lines(tmp_path, lines))
+    assert "bad.traj:2:999:" in msg and "at most 998" in msg
+
+
+def test_two_rad_jump_is_refused(tmp_path):
+    q = np.zeros((4, 40))
+    q[2:, JOINT_NAMES.index("RSP")] = -2.0
+    path = tmp_path / "bad.traj"
+    write_trajectory(path, q)
+    msg = _fail(path, rate=25.0)
+    assert "bad.traj:3:" in msg and "(RSP)" in msg and "50 rad/s" in msg
+
+
+def test_value_outside_joint_limit_is_refused(tmp_path):
+    q = np.zeros((2, 40))
+    q[:, JOINT_NAMES.index("LKN")] = -0.2  # knees do not bend backwards
+    path = tmp_path / "bad.traj"
+    write_trajectory(path, q)
+    msg = _fail(path)
+    assert "bad.traj:1:" in msg and "(LKN)" in msg and "[0, 2.61]" in msg
+
+
+def test_every_problem_is_reported_not_only_the_first(tmp_path):
+    lines = format_trajectory(_smooth_trajectory(6)).splitlines()
+    lines[1] = "0 0 0"
+    lines[4] = lines[4].replace(lines[4].split()[0], "x", 1)
+    with pytest.raises(TrajectoryFileError) as err:
+        read_trajectory(_write_lines(tmp_path, lines), 25.0)
+    assert [p.split(":")[1] for p in err.value.problems] == ["2", "5"]
+
+
+def test_empty_and_missing_files(tmp_path):
+    empty = tmp_path / "empty.traj"
+    empty.write_text("")
+    assert "no trajectory lines" in _fail(empty)
+    assert "cannot read" in _fail(tmp_path / "missing.traj")
