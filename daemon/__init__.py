@@ -1,0 +1,49 @@
+"""The daemon side: per-joint control law (and, alongside, channels and backends).
+
+Re-exports only light, numpy-only names; backends (MuJoCo, CAN) are imported from their
+own modules when needed.
+"""
+
+from daemon.control_modes import (
+    DAEMON_RATE_HZ,
+    TICK_S,
+    ReferenceFilterConfig,
+    ReferenceModeError,
+    RefMode,
+    default_filter_config,
+)
+from daemon.joint_control import (
+    ComplianceState,
+    ControlInputError,
+    ControlOutput,
+    JointController,
+    default_compliance_capable,
+)
+from daemon.pwm import (
+    DRC_DOCUMENTED_GAINS,
+    PwmGainError,
+    PwmGains,
+    default_drc_gains,
+    pwm_duty,
+    validate_pwm_gains,
+)
+
+__all__ = [
+    "DAEMON_RATE_HZ",
+    "DRC_DOCUMENTED_GAINS",
+    "TICK_S",
+    "ComplianceState",
+    "ControlInputError",
+    "ControlOutput",
+    "JointController",
+    "PwmGainError",
+    "PwmGains",
+    "RefMode",
+    "ReferenceFilterConfig",
+    "ReferenceModeError",
+    "default_compliance_capable",
+    "default_drc_gains",
+    "default_filter_config",
+    "pwm_duty",
+    "validate_pwm_gains",
+]

@@ -1,0 +1,353 @@
+"""PWM (compliance) mode: the per-joint PD duty, its gains and their safety limits.
+
+In PWM mode hubo-ach switched the motor board's position loop off and drove the motor
+with an open-loop duty cycle it computed every tick (hubo-facts §3)::
+
+    duty = −(kp·(r − pos) − kd·vel + pwm_command),   clamped to ±max_pwm
+
+Units, as hubo-ach defined them:
+
+- ``kp``: percent duty per radian of error [%/rad];
+- ``kd``: percent duty removed per rad/s of joint velocity [%/(rad/s)];
+- ``pwm_command``: a constant feed-forward (gravity) duty [%];
+- ``max_pwm``: the clamp [%].
+
+The C code multiplied every term by 10 and worked in integer 0.1 % units, the resolution
+of the board's high-resolution PWM frame; we compute in percent as floats and
+:func:`duty_to_board_units` converts for a CAN backend. The sign is hubo-ach's: a joint
+below its reference (``r > pos``) gets a negative duty. A backend (CAN frame direction
+bit, MuJoCo motor model) must apply that same motor-direction convention.
+
+``r`` is the reference the daemon sends this tick (after the reference filter of
+``daemon.control_modes``): hubo-ach computed the duty from the joint's sent reference, so
+a compliant arm in mode FILTER follows the filtered trajectory, and in mode COMPLIANT
+(``r = pos``) only damping and feed-forward act.
+
+Safety limits (thesis manual): ``kp < 70``, ``kd < 10``, ``max_pwm < 8``. The original
+code checked none of them; here every path that sets gains (CLI, console, channel) goes
+through :func:`validate_pwm_gains`, and :class:`PwmGains` cannot hold unsafe values.
+
+The DRC-Hubo default gains break those limits (shoulder pitch/roll 80/0/8, shoulder yaw
+70/0/7). Decision: the documented table stays here, verbatim, as reference data
+(:data:`DRC_DOCUMENTED_GAINS`), and the default set :func:`default_drc_gains` clips each
+field to the largest value inside its limit at the resolution the original used: kp to
+69 (integer gains in ``joint.table``) and max_pwm to 7.9 % (0.1 % units). Other values are
+kept. Effect on the shoulders: stiffness −14 % (80 → 69 %/rad), peak duty −1.25 %
+(8 → 7.9 %), so the duty saturates at 0.114 rad of error instead of 0.100 rad; the
+shoulder yaw only loses kp (70 → 69). We clip field by field rather than scale a joint's
+gains together because the peak duty (what holds the arm on the rail) is what a grasp
+needs, and the limit is on each field separately.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+from types import MappingProxyType
+
+import numpy as np
+
+from robot.errors import InputError
+from robot.joints import JOINT_INDEX, JOINT_NAMES, NUM_JOINTS
+
+__all__ = [
+    "DRC_DOCUMENTED_GAINS",
+    "GAIN_LIMITS",
+    "GainLimit",
+    "KD_LIMIT",
+    "KP_LIMIT",
+    "MAX_PWM_LIMIT_PCT",
+    "PWM_COMMAND_LIMIT_PCT",
+    "SAFE_KP",
+    "SAFE_MAX_PWM_PCT",
+    "PwmGainError",
+    "PwmGains",
+    "default_drc_gains",
+    "duty_to_board_units",
+    "pwm_duty",
+    "validate_pwm_gains",
+]
+
+KP_LIMIT = 70.0  # [%/rad] kp must stay strictly below (thesis manual)
+KD_LIMIT = 10.0  # [%/(rad/s)] kd must stay strictly below (thesis manual)
+MAX_PWM_LIMIT_PCT = 8.0  # [%] max_pwm must stay strictly below (thesis manual)
+PWM_COMMAND_LIMIT_PCT = 100.0  # [%] a feed-forward beyond full duty is meaningless
+
+#: The largest kp inside the limit at ``joint.table``'s integer resolution [%/rad].
+SAFE_KP = 69.0
+#: The largest max_pwm inside the limit at the board's 0.1 % resolution [%].
+SAFE_MAX_PWM_PCT = 7.9
+
+
+@dataclass(frozen=True)
+class GainLimit:
+    """Allowed interval of one gain field: ``low <= value`` and ``value < high``.
+
+    ``high_inclusive`` turns the upper bound into ``value <= high``.
+    """
+
+    low: float
+    high: float
+    high_inclusive: bool = False
+    unit: str = ""
+
+    def contains(self, values: np.ndarray) -> np.ndarray:
+        """Elementwise membership (NaN is never inside)."""
+        upper = values <= self.high if self.high_inclusive else values < self.high
+        return (values >= self.low) & upper
+
+    def __str__(self) -> str:
+        return f"[{self.low:g}, {self.high:g}{']' if self.high_inclusive else ')'} {self.unit}"
+
+
+#: Allowed range of each field of :class:`PwmGains`, by field name.
+GAIN_LIMITS: Mapping[str, GainLimit] = MappingProxyType(
+    {
+        "kp": GainLimit(0.0, KP_LIMIT, unit="%/rad"),
+        "kd": GainLimit(0.0, KD_LIMIT, unit="%/(rad/s)"),
+        "max_pwm_pct": GainLimit(0.0, MAX_PWM_LIMIT_PCT, unit="%"),
+        "pwm_command_pct": GainLimit(-PWM_COMMAND_LIMIT_PCT, PWM_COMMAND_LIMIT_PCT, True, "%"),
+    }
+)
+
+
+def _arm_table(elbow: tuple[float, float, float]) -> dict[str, tuple[float, float, float]]:
+    return {
+        "SP": (80.0, 0.0, 8.0),
+        "SR": (80.0, 0.0, 8.0),
+        "SY": (70.0, 0.0, 7.0),
+        "EB": elbow,
+        "WY": (50.0, 0.0, 5.0),
+        "WP": (40.0, 0.0, 4.0),
+    }
+
+
+#: DRC-Hubo default PWM gains as documented (hubo-facts §3), joint → (kp, kd, max_pwm %).
+#: Reference data only: several entries break the safety limits, so :class:`PwmGains`
+#: refuses this table; :func:`default_drc_gains` is the safe set derived from it.
+#: Joints not listed (legs, wrist roll, neck, waist, fingers) are 0/0/0: limp if compliant.
+DRC_DOCUMENTED_GAINS: Mapping[str, tuple[float, float, float]] = MappingProxyType(
+    {
+        side + s: g
+        for side, elbow in (("R", (50.0, 0.0, 5.0)), ("L", (40.0, 0.0, 4.0)))
+        for s, g in _arm_table(elbow).items()
+    }
+)
+
+
+class PwmGainError(InputError):
+    """PWM gains outside the safety limits; every problem names joint, field, value, range."""
+
+    def __init__(self, problems: list[str]):
+        self.problems = problems
+        super().__init__(
+            "\n".join(problems)
+            + "\n(thesis manual safety rules: kp < 70, kd < 10, max_pwm < 8; gains refused)"
+        )
+
+
+def _per_joint(name: str, value: float | np.ndarray, joints: tuple[str, ...]) -> np.ndarray:
+    arr = np.asarray(value, dtype=float)
+    if arr.ndim == 0:
+        return np.full(len(joints), float(arr))
+    if arr.shape != (len(joints),):
+        raise PwmGainError([f"{name} has shape {arr.shape}; expected () or ({len(joints)},)"])
+    return arr
+
+
+def validate_pwm_gains(
+    kp: float | np.ndarray,
+    kd: float | np.ndarray,
+    max_pwm_pct: float | np.ndarray,
+    pwm_command_pct: float | np.ndarray = 0.0,
+    joints: Iterable[str] | None = None,
+) -> None:
+    """Refuses PWM gains outside the safety limits. Every path that sets gains calls this.
+
+    Limits: ``0 <= kp < 70`` [%/rad], ``0 <= kd < 10`` [%/(rad/s)],
+    ``0 <= max_pwm < 8`` [%], ``|pwm_command| <= 100`` [%]; NaN and inf are refused.
+
+    Args:
+        kp: proportional gain [%/rad], a scalar or one value per joint.
+        kd: damping gain [%/(rad/s)], a scalar or one value per joint.
+        max_pwm_pct: duty clamp [%], a scalar or one value per joint.
+        pwm_command_pct: feed-forward duty [%], a scalar or one value per joint.
+        joints: the joint names the values belong to; all 40 in file order when None.
+
+    Raises:
+        PwmGainError: one line per offending joint and field, e.g.
+            ``RSP kp = 80 is outside the allowed range [0, 70) %/rad``.
+        InputError: an unknown joint name.
+    """
+    names = JOINT_NAMES if joints is None else tuple(joints)
+    unknown = [n for n in names if n not in JOINT_INDEX]
+    if unknown:
+        raise InputError(f"unknown joint(s) {unknown}; valid names: {' '.join(JOINT_NAMES)}")
+    fields = {"kp": kp, "kd": kd, "max_pwm_pct": max_pwm_pct, "pwm_command_pct": pwm_command_pct}
+    problems: list[str] = []
+    for field, value in fields.items():
+        arr = _per_joint(field, value, names)
+        limit = GAIN_LIMITS[field]
+        for i in np.flatnonzero(~limit.contains(arr)):
+            problems.append(f"{names[i]} {field} = {arr[i]:g} is outside the allowed range {limit}")
+    if problems:
+        raise PwmGainError(problems)
+
+
+def _frozen(values: float | np.ndarray) -> np.ndarray:
+    arr = np.array(np.broadcast_to(np.asarray(values, dtype=float), (NUM_JOINTS,)))
+    arr.setflags(write=False)
+    return arr
+
+
+@dataclass(frozen=True, eq=False)
+class PwmGains:
+    """PWM gains of all 40 joints, validated on construction (``hubo-pwm-gains``).
+
+    Attributes:
+        kp: proportional gain [%/rad], shape (40,).
+        kd: damping gain [%/(rad/s)], shape (40,).
+        max_pwm_pct: duty clamp [%], shape (40,).
+        pwm_command_pct: feed-forward duty [%], shape (40,).
+    """
+
+    kp: np.ndarray
+    kd: np.ndarray
+    max_pwm_pct: np.ndarray
+    pwm_command_pct: np.ndarray
+
+    def __post_init__(self) -> None:
+        validate_pwm_gains(self.kp, self.kd, self.max_pwm_pct, self.pwm_command_pct)
+        for field in ("kp", "kd", "max_pwm_pct", "pwm_command_pct"):
+            object.__setattr__(self, field, _frozen(getattr(self, field)))
+
+    @classmethod
+    def zeros(cls) -> PwmGains:
+        """All gains zero: every compliant joint is limp."""
+        return cls(
+            np.zeros(NUM_JOINTS), np.zeros(NUM_JOINTS), np.zeros(NUM_JOINTS), np.zeros(NUM_JOINTS)
+        )
+
+    @classmethod
+    def from_table(cls, table: Mapping[str, tuple[float, float, float]]) -> PwmGains:
+        """Gains from ``joint → (kp, kd, max_pwm %)``; unlisted joints get 0/0/0.
+
+        Raises:
+            PwmGainError: a value is outside the safety limits.
+            InputError: an unknown joint name.
+        """
+        names = tuple(table)
+        values = np.array([table[n] for n in names], dtype=float).reshape(len(names), 3)
+        validate_pwm_gains(values[:, 0], values[:, 1], values[:, 2], 0.0, joints=names)
+        kp, kd, max_pwm = (np.zeros(NUM_JOINTS) for _ in range(3))
+        for name, (p, d, m) in zip(names, values, strict=True):
+            j = JOINT_INDEX[name]
+            kp[j], kd[j], max_pwm[j] = p, d, m
+        return cls(kp, kd, max_pwm, np.zeros(NUM_JOINTS))
+
+    def with_joint(
+        self,
+        joint: str,
+        *,
+        kp: float | None = None,
+        kd: float | None = None,
+        max_pwm_pct: float | None = None,
+        pwm_command_pct: float | None = None,
+    ) -> PwmGains:
+        """A copy with one joint's gains changed (the console / channel path).
+
+        Raises:
+            PwmGainError: a new value is outside the safety limits.
+            InputError: an unknown joint name.
+        """
+        if joint not in JOINT_INDEX:
+            raise InputError(f"unknown joint {joint!r}; valid names: {' '.join(JOINT_NAMES)}")
+        j = JOINT_INDEX[joint]
+        new = {}
+        for field, value in (
+            ("kp", kp),
+            ("kd", kd),
+            ("max_pwm_pct", max_pwm_pct),
+            ("pwm_command_pct", pwm_command_pct),
+        ):
+            arr = np.array(getattr(self, field))
+            if value is not None:
+                arr[j] = value
+            new[field] = arr
+        validate_pwm_gains(
+            new["kp"][j],
+            new["kd"][j],
+            new["max_pwm_pct"][j],
+            new["pwm_command_pct"][j],
+            joints=(joint,),
+        )
+        return PwmGains(**new)
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, PwmGains):
+            return NotImplemented
+        return all(
+            np.array_equal(getattr(self, f), getattr(other, f))
+            for f in ("kp", "kd", "max_pwm_pct", "pwm_command_pct")
+        )
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def __repr__(self) -> str:
+        active = [
+            f"{JOINT_NAMES[j]}={self.kp[j]:g}/{self.kd[j]:g}/{self.max_pwm_pct[j]:g}"
+            for j in np.flatnonzero((self.kp != 0) | (self.kd != 0) | (self.max_pwm_pct != 0))
+        ]
+        return f"PwmGains(kp/kd/max_pwm%: {', '.join(active) or 'all zero'})"
+
+
+def default_drc_gains() -> PwmGains:
+    """The safe DRC-Hubo default gains.
+
+    :data:`DRC_DOCUMENTED_GAINS` with each field clipped into the safety limits:
+    kp ≤ 69 [%/rad] and max_pwm ≤ 7.9 [%] (kd is 0 in the table). Shoulder pitch and
+    roll become 69/0/7.9, shoulder yaw 69/0/7; elbows and wrists are unchanged; every
+    other joint is 0/0/0 (limp when compliant). See the module docstring for why.
+    """
+    safe = {
+        name: (min(kp, SAFE_KP), kd, min(max_pwm, SAFE_MAX_PWM_PCT))
+        for name, (kp, kd, max_pwm) in DRC_DOCUMENTED_GAINS.items()
+    }
+    return PwmGains.from_table(safe)
+
+
+def pwm_duty(
+    ref_rad: np.ndarray,
+    pos_rad: np.ndarray,
+    vel_rad_s: np.ndarray,
+    gains: PwmGains,
+) -> tuple[np.ndarray, np.ndarray]:
+    """The PWM duty of every joint, hubo-ach's formula and sign.
+
+    ``duty = −(kp·(r − pos) − kd·vel + pwm_command)``, clamped to ``±max_pwm``.
+
+    Args:
+        ref_rad: reference r the joint should hold [rad], shape (40,).
+        pos_rad: measured position [rad], shape (40,).
+        vel_rad_s: measured velocity [rad/s], shape (40,).
+        gains: validated gains.
+
+    Returns:
+        ``(duty_pct, saturated)``: duty [%] in ``[−max_pwm, max_pwm]`` and a bool mask of
+        the joints where the clamp acted.
+    """
+    raw = -(gains.kp * (ref_rad - pos_rad) - gains.kd * vel_rad_s + gains.pwm_command_pct)
+    duty = np.clip(raw, -gains.max_pwm_pct, gains.max_pwm_pct)
+    return duty, duty != raw
+
+
+def duty_to_board_units(duty_pct: np.ndarray) -> np.ndarray:
+    """Duty in the motor board's integer 0.1 % units (what hubo-ach put in the CAN frame).
+
+    Args:
+        duty_pct: duty [%].
+
+    Returns:
+        int32 array, ``round(10·duty)`` [0.1 %].
+    """
+    return np.rint(np.asarray(duty_pct, dtype=float) * 10.0).astype(np.int32)
