@@ -191,7 +191,9 @@ def _arm(p: RobotParams, side: str) -> tuple[list[Link], list[Frame]]:
     palm_z = -p.wrist_to_palm_m
     # The grip centre (palm frame) is where a grasped rail's axis lies; the palm plate sits
     # on the outer side of it, the fingers start above it and curl over it.
-    palm_plate = Geom("box", (0.0, -s * 0.035, palm_z + 0.01), half=hand_half)
+    # The rail enters the hand from its open side, +s·y; plate and open fingers clear a
+    # 25 mm-radius rail at the grip centre by 5 mm.
+    palm_plate = Geom("box", (0.0, -s * 0.05, palm_z + 0.01), half=hand_half)
     finger_mass = m["hand"] * 0.3 / 5
     palm_mass = m["WR"] + m["hand"] * 0.7
     links = [
@@ -211,18 +213,18 @@ def _arm(p: RobotParams, side: str) -> tuple[list[Link], list[Frame]]:
     lo, hi = _limits(p, f"{side}WR")
     links.append(
         Link(f"{side}_hand", f"{side}_wrist_pitch", wr_joint, (0, 0, 1), (0, 0, 0), palm_mass,
-             (0.0, -s * 0.02, palm_z + 0.01), _box_inertia(palm_mass, hand_half), (palm_plate,),
+             (0.0, -s * 0.04, palm_z + 0.01), _box_inertia(palm_mass, hand_half), (palm_plate,),
              lo, hi, _torque(p, f"{side}WR"), _speed_max(p, f"{side}WR"),
              _armature(p, f"{side}WR"))
     )
-    # Five fingers spaced along the grip axis (x), each curling about x towards +y (left
-    # hand: towards -y), so positive curl closes both hands.
+    # Five fingers spaced along the grip axis (x), each curling about ±x across the grip
+    # centre towards the open side, so positive curl closes both hands.
     for i in range(5):
         x = -0.036 + 0.018 * i
         joint = f"{side}F{i + 1}"
         links.append(
-            _limb(f"{side}_finger{i + 1}", f"{side}_hand", joint, (-s, 0, 0),
-                  (x, -s * 0.03, palm_z + 0.045), finger_mass, FINGER_LENGTH_M,
+            _limb(f"{side}_finger{i + 1}", f"{side}_hand", joint, (s, 0, 0),
+                  (x, -s * 0.04, palm_z + 0.045), finger_mass, FINGER_LENGTH_M,
                   FINGER_RADIUS_M, p)
         )
     frames = [Frame(f"{side}_palm", f"{side}_hand", (0.0, 0.0, palm_z))]

@@ -1,0 +1,83 @@
+"""Turning seed holds (relative to rungs and rails) into concrete `Hold`s on a ladder."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ladders.geometry import LadderGeometry
+from planner.contacts import Hold
+from primitives.hold_seeds import FloorSeed, HoldSeed, RailSeed, RungSeed
+from robot.params import RobotParams
+
+#: A cylinder rung supports the sole along a line; model it as a strip this wide [m].
+CYLINDER_SUPPORT_STRIP_M = 0.01
+
+
+def _pose(R: np.ndarray, p: np.ndarray) -> np.ndarray:
+    T = np.eye(4)
+    T[:3, :3], T[:3, 3] = R, p
+    return T
+
+
+def palm_rotation(geom: LadderGeometry, side: str) -> np.ndarray:
+    """R_world_palm of a hand closed on a rail.
+
+    The grip axis (palm x) runs along the rail; the open side of the hand (s·y_palm, s = +1
+    left, −1 right) faces into the ladder so the hand can back off towards the climber;
+    the wrist (palm +z) is then inboard of the rail.
+    """
+    s = 1.0 if side == "left" else -1.0
+    d, n = geom.ladder_direction, geom.rung_line_normal
+    x = -d
+    y = -s * n
+    return np.column_stack([x, y, np.cross(x, y)])
+
+
+def rail_point(geom: LadderGeometry, side: str, rung: int, along_m: float = 0.0) -> np.ndarray:
+    """Point of a rail axis vertically above rung ``rung`` (any index), moved ``along_m``
+    up the rail [m]."""
+    p0, _ = geom.rail_axis(side)
+    spec = geom.spec
+    s_m = spec.rung_height_m(rung) / np.sin(spec.slope_rad) + along_m
+    return p0 + s_m * geom.ladder_direction
+
+
+def sole_contact_points(params: RobotParams, T_world_sole: np.ndarray,
+                        x_range_m: tuple[float, float]) -> np.ndarray:
+    """Four corners of the sole part between ``x_range_m`` (sole frame x) [m], world."""
+    hy = params.foot_width_m / 2
+    (x0, x1) = x_range_m
+    local = np.array([[x1, hy, 0], [x1, -hy, 0], [x0, -hy, 0], [x0, hy, 0]], dtype=float)
+    return local @ T_world_sole[:3, :3].T + T_world_sole[:3, 3]
+
+
+def make_hold(seed: HoldSeed, geom: LadderGeometry, params: RobotParams,
+              floor_pose: dict[str, np.ndarray] | None = None, offset_m=(0.0, 0.0)) -> Hold:
+    """A concrete hold for a seed, shifted by ``offset_m`` = (along, lateral) in L [m]."""
+    mu = geom.spec.friction
+    up = np.array([0.0, 0.0, 1.0])
+    hl = params.foot_length_m / 2
+    if isinstance(seed, FloorSeed):
+        T = floor_pose[seed.limb]
+        pts = sole_contact_points(params, T, (-hl, hl))
+        return Hold(seed.limb, "floor", T, pts, np.tile(up, (4, 1)), mu)
+    if isinstance(seed, RungSeed):
+        along, lateral = seed.along_m + offset_m[0], seed.lateral_m + offset_m[1]
+        p = geom.rung_top_point(seed.rung, lateral_m=lateral, along_m=along)
+        T = _pose(geom.R_world_ladder, p)
+        half_tread = (geom.spec.rung_depth_m / 2 if geom.spec.rung_shape == "box"
+                      else CYLINDER_SUPPORT_STRIP_M / 2)
+        # The tread spans [-along - half, -along + half] in the sole frame; clip to the sole.
+        x0, x1 = max(-hl, -along - half_tread), min(hl, -along + half_tread)
+        if x1 <= x0:
+            raise ValueError(f"the sole does not overlap rung {seed.rung} at offset {along} m")
+        pts = sole_contact_points(params, T, (x0, x1))
+        return Hold(seed.limb, seed.target, T, pts, np.tile(up, (4, 1)), mu)
+    if isinstance(seed, RailSeed):
+        p = rail_point(geom, seed.side, seed.rung, seed.along_m + offset_m[0])
+        T = _pose(palm_rotation(geom, seed.side), p)
+        # Thesis hand hold: a contact pushing up and one pulling the hand towards the ladder.
+        towards_ladder = geom.R_world_ladder @ np.array([1.0, 0.0, 0.0])
+        return Hold(seed.limb, seed.target, T, np.vstack([p, p]),
+                    np.vstack([up, towards_ladder]), mu)
+    raise TypeError(f"unknown seed {seed!r}")

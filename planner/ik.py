@@ -1,0 +1,158 @@
+"""Whole-body IK with placo: keep the supporting holds, reach the moving limbs' targets.
+
+Supporting holds are hard tasks (a foot: full pose; a hand: position plus grip axis along
+the rail); moving targets are soft with a high weight, so an unreachable target yields
+a best effort whose residual is reported instead of an infeasible QP. The CoM is kept
+inside a (clockwise) support polygon by a hard constraint; a soft posture task pulls
+towards the primitive's seed posture.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from planner.contacts import Hold
+from planner.kinematics import HuboKinematics
+
+log = logging.getLogger(__name__)
+
+#: Joints the IK never moves: fingers are set by the grasp schedule, the neck stays still.
+FIXED_JOINT_PREFIXES = ("RF", "LF", "NK")
+
+
+@dataclass(frozen=True)
+class IKConfig:
+    """Tunables of the IK projection."""
+
+    max_iterations: int = 80
+    step_dt_s: float = 0.02
+    position_tol_m: float = 1e-4
+    angle_tol_rad: float = 2e-3
+    moving_position_weight: float = 100.0
+    moving_orientation_weight: float = 10.0
+    posture_weight: float = 1e-2
+    torso_upright_weight: float = 0.5
+    regularization: float = 1e-4
+    com_margin_m: float = 0.01
+
+
+@dataclass
+class IKResult:
+    q: np.ndarray = field(repr=False)
+    converged: bool
+    iterations: int
+    position_error_m: float
+    angle_error_rad: float
+
+    def __repr__(self) -> str:
+        return (f"IKResult({'converged' if self.converged else 'NOT converged'} in "
+                f"{self.iterations} it, {self.position_error_m * 1000:.2f} mm, "
+                f"{np.degrees(self.angle_error_rad):.2f} deg)")
+
+
+def _grip_axis(hold_T: np.ndarray) -> np.ndarray:
+    return hold_T[:3, 0]
+
+
+def _hold_error(kin: HuboKinematics, limb_frame: str, T_target: np.ndarray,
+                is_hand: bool) -> tuple[float, float]:
+    T = kin.wrapper.get_T_world_frame(limb_frame)
+    dp = float(np.linalg.norm(T[:3, 3] - T_target[:3, 3]))
+    if is_hand:  # only the grip axis is constrained
+        c = float(np.clip(T[:3, 0] @ T_target[:3, 0], -1, 1))
+    else:
+        c = float(np.clip((np.trace(T[:3, :3].T @ T_target[:3, :3]) - 1) / 2, -1, 1))
+    return dp, float(np.arccos(c))
+
+
+def solve_ik(kin: HuboKinematics, q_seed: np.ndarray, support: tuple[Hold, ...],
+             moving: tuple[Hold, ...] = (), *, posture_rad: dict[str, float] | None = None,
+             torso_R: np.ndarray | None = None, pelvis_target_m: np.ndarray | None = None,
+             pelvis_weight: float = 0.0, com_polygon_cw: np.ndarray | None = None,
+             config: IKConfig = IKConfig()) -> IKResult:
+    """Project ``q_seed`` onto the holds and pull the moving limbs to their targets.
+
+    Args:
+        kin: robot model; its state is overwritten.
+        q_seed: starting configuration (pinocchio layout).
+        support: holds that must be kept (hard).
+        moving: targets of moving limbs (soft, high weight).
+        posture_rad: preferred angle per joint (soft).
+        torso_R: preferred torso orientation (soft), usually facing the ladder, upright.
+        pelvis_target_m: preferred pelvis position (soft, ``pelvis_weight``).
+        com_polygon_cw: clockwise CoM polygon (k, 2) to stay inside, with margin.
+
+    Returns:
+        The result; ``converged`` means every hold and target is met within tolerance.
+    """
+    robot = kin.wrapper
+    kin.set_q(q_seed)
+    solver = robot.make_solver()
+    solver.mask_fbase(False)
+    solver.enable_joint_limits(True)
+    # Bounding each step by the joints' speed limits × dt keeps the linearised hard tasks
+    # valid; unbounded steps from a far soft target made the QP diverge.
+    solver.dt = config.step_dt_s
+    solver.enable_velocity_limits(True)
+    for name in robot.joint_names():
+        if name.startswith(FIXED_JOINT_PREFIXES):
+            solver.mask_dof(name)
+    for hold in support:
+        _add_hold_task(solver, hold, "hard", 1.0, 1.0)
+    for hold in moving:
+        _add_hold_task(solver, hold, "soft", config.moving_position_weight,
+                       config.moving_orientation_weight)
+    if posture_rad:
+        names = {n for n in robot.joint_names()}
+        jt = solver.add_joints_task()
+        jt.set_joints({k: v for k, v in posture_rad.items() if k in names})
+        jt.configure("posture", "soft", config.posture_weight)
+    if torso_R is not None:
+        ot = solver.add_orientation_task("torso_frame", torso_R)
+        ot.configure("torso_upright", "soft", config.torso_upright_weight)
+    if pelvis_target_m is not None and pelvis_weight > 0:
+        pt = solver.add_position_task("pelvis", np.asarray(pelvis_target_m, dtype=float))
+        pt.configure("pelvis", "soft", pelvis_weight)
+    if com_polygon_cw is not None:
+        cc = solver.add_com_polygon_constraint(np.asarray(com_polygon_cw, dtype=float),
+                                               config.com_margin_m)
+        cc.configure("com_polygon", "hard")
+    solver.add_regularization_task(config.regularization)
+    holds = support + moving
+    it = 0
+    pos_err = ang_err = np.inf
+    for it in range(1, config.max_iterations + 1):
+        robot.update_kinematics()
+        try:
+            solver.solve(True)
+        except RuntimeError as exc:  # placo reports infeasible QPs as bare RuntimeErrors
+            log.debug("IK QP failed at iteration %d: %s", it, exc)
+            break
+        robot.update_kinematics()
+        errs = [_hold_error(kin, h.frame, h.T_world_frame, h.is_hand) for h in holds]
+        pos_err = max((e[0] for e in errs), default=0.0)
+        ang_err = max((e[1] for e in errs), default=0.0)
+        if pos_err < config.position_tol_m and ang_err < config.angle_tol_rad and it > 2:
+            break
+    converged = bool(pos_err < config.position_tol_m and ang_err < config.angle_tol_rad)
+    return IKResult(kin.q, converged, it, float(pos_err), float(ang_err))
+
+
+def _add_hold_task(solver, hold: Hold, priority: str, w_pos: float, w_ori: float) -> None:
+    name = hold.limb
+    if hold.is_hand:
+        t = solver.add_position_task(hold.frame, hold.T_world_frame[:3, 3].copy())
+        t.configure(f"{name}_position", priority, w_pos)
+        a = solver.add_axisalign_task(hold.frame, np.array([1.0, 0.0, 0.0]),
+                                      _grip_axis(hold.T_world_frame).copy())
+        a.configure(f"{name}_grip_axis", priority, w_ori)
+        # Open side of the hand towards the ladder: soft even for a support hold.
+        b = solver.add_axisalign_task(hold.frame, np.array([0.0, 1.0, 0.0]),
+                                      hold.T_world_frame[:3, 1].copy())
+        b.configure(f"{name}_open_side", "soft", 0.1)
+    else:
+        t = solver.add_frame_task(hold.frame, hold.T_world_frame.copy())
+        t.configure(name, priority, w_pos, w_ori)

@@ -1,0 +1,102 @@
+"""Contact-space recursive interpolation (thesis §6.3.1).
+
+Between two configurations feasible at the same stance: take the joint-space midpoint,
+project it by IK so the supporting limbs stay on their holds (and a moving limb stays on
+the straight line between its two poses), check it, and recurse on both halves until
+neighbours are closer than the resolution.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from planner.contacts import Hold, Stance
+from planner.ik import IKConfig, solve_ik
+from planner.kinematics import HuboKinematics
+from planner.validity import FeasibilityChecker
+
+#: The projection's pull towards the joint-space midpoint (keeps it local).
+MIDPOINT_POSTURE_WEIGHT = 0.1
+
+
+class InterpolationError(Exception):
+    """A midpoint could not be projected, or its projection is infeasible."""
+
+    def __init__(self, reason: str, depth: int):
+        super().__init__(f"{reason} (recursion depth {depth})")
+        self.reason = reason
+        self.depth = depth
+
+
+@dataclass
+class InterpolationStats:
+    projections: int = 0
+    max_depth: int = 0
+    min_margin_m: float = np.inf
+    max_torque_ratio: float = 0.0
+
+
+def _interp_pose(Ta: np.ndarray, Tb: np.ndarray, s: float) -> np.ndarray:
+    """Position linear, rotation along the geodesic."""
+    from scipy.spatial.transform import Rotation, Slerp
+
+    T = np.eye(4)
+    T[:3, 3] = (1 - s) * Ta[:3, 3] + s * Tb[:3, 3]
+    slerp = Slerp([0, 1], Rotation.from_matrix([Ta[:3, :3], Tb[:3, :3]]))
+    T[:3, :3] = slerp([s]).as_matrix()[0]
+    return T
+
+
+def contact_space_interpolate(kin: HuboKinematics, checker: FeasibilityChecker,
+                              qa: np.ndarray, qb: np.ndarray, support: tuple[Hold, ...],
+                              stability_stance: Stance, contacts: dict[str, str], *,
+                              moving: Hold | None = None, resolution_rad: float = 0.01,
+                              max_depth: int = 14, ik_config: IKConfig = IKConfig(),
+                              stats: InterpolationStats | None = None) -> list[np.ndarray]:
+    """Configurations from ``qa`` (excluded) to ``qb`` (included), each within
+    ``resolution_rad`` of the next in every joint, all on the contact constraints.
+
+    Args:
+        moving: if given, a hold template whose frame moves; its target at each midpoint
+            is the pose halfway between its poses at the two neighbours.
+
+    Raises:
+        InterpolationError: a midpoint did not project or is infeasible.
+    """
+    stats = stats if stats is not None else InterpolationStats()
+    region = checker.region(stability_stance)
+    polygon = None if region.is_empty else region.clockwise_vertices()
+
+    def rec(q0: np.ndarray, q1: np.ndarray, depth: int) -> list[np.ndarray]:
+        if kin.joint_distance(q0, q1) <= resolution_rad:
+            return [q1]
+        if depth >= max_depth:
+            raise InterpolationError("resolution not reached", depth)
+        stats.max_depth = max(stats.max_depth, depth + 1)
+        qm = kin.interpolate(q0, q1, 0.5)
+        moving_targets: tuple[Hold, ...] = ()
+        if moving is not None:
+            Tm = _interp_pose(kin.frame_pose(q0, moving.frame), kin.frame_pose(q1, moving.frame),
+                              0.5)
+            moving_targets = (Hold(moving.limb, moving.target, Tm, moving.points_m,
+                                   moving.normals, moving.friction),)
+        posture = {name: float(qm[kin.model.joints[kin.model.getJointId(name)].idx_q])
+                   for name in kin.wrapper.joint_names()}
+        cfg = IKConfig(**{**ik_config.__dict__, "posture_weight": MIDPOINT_POSTURE_WEIGHT,
+                          "torso_upright_weight": 0.0})
+        res = solve_ik(kin, qm, support, moving_targets, posture_rad=posture,
+                       com_polygon_cw=polygon, config=cfg)
+        stats.projections += 1
+        if not res.converged:
+            raise InterpolationError(f"projection failed: {res!r}", depth)
+        # The hand's fingers are not moved by IK: carry them over from the midpoint.
+        verdict = checker.check(res.q, stability_stance, contacts)
+        if not verdict.ok:
+            raise InterpolationError(f"midpoint infeasible: {verdict.reason}", depth)
+        stats.min_margin_m = min(stats.min_margin_m, verdict.com_margin_m)
+        stats.max_torque_ratio = max(stats.max_torque_ratio, verdict.torque_ratio)
+        return rec(q0, res.q, depth + 1) + rec(res.q, q1, depth + 1)
+
+    return rec(qa, qb, 0)

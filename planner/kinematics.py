@@ -1,0 +1,76 @@
+"""The planner's view of the robot: one placo wrapper (whose model is a pinocchio model),
+conversions between its configuration vector and the 40 file columns, frame poses, CoM.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+import placo
+
+from robot.joints import JOINT_NAMES
+from robot.params import RobotParams, robot_params
+from robot.urdf import robot_urdf
+
+
+@dataclass
+class HuboKinematics:
+    """placo/pinocchio model of one robot, plus the column ↔ configuration mapping.
+
+    A configuration ``q`` is pinocchio's: base position (3), base quaternion x y z w (4),
+    then the revolute joints in model order.
+    """
+
+    params: RobotParams
+    wrapper: placo.RobotWrapper
+    model: pin.Model
+    data: pin.Data
+    q_index_of_column: np.ndarray  # (40,) index into q, or -1 for a column with no joint
+
+    @classmethod
+    def load(cls, robot: str = "drc-hubo") -> HuboKinematics:
+        params = robot_params(robot)
+        wrapper = placo.RobotWrapper("", placo.Flags.ignore_collisions, robot_urdf(params))
+        model = wrapper.model
+        index = np.full(len(JOINT_NAMES), -1)
+        for k, name in enumerate(JOINT_NAMES):
+            if model.existJointName(name):
+                index[k] = model.joints[model.getJointId(name)].idx_q
+        return cls(params, wrapper, model, model.createData(), index)
+
+    @property
+    def q(self) -> np.ndarray:
+        return np.array(self.wrapper.state.q)
+
+    def set_q(self, q: np.ndarray) -> None:
+        self.wrapper.state.q = np.asarray(q, dtype=float).copy()
+        self.wrapper.update_kinematics()
+
+    def columns(self, q: np.ndarray) -> np.ndarray:
+        """The 40 file columns [rad] of configuration ``q``."""
+        out = np.zeros(len(JOINT_NAMES))
+        have = self.q_index_of_column >= 0
+        out[have] = q[self.q_index_of_column[have]]
+        return out
+
+    def actuated(self, q: np.ndarray) -> np.ndarray:
+        """The revolute part of ``q`` (model order)."""
+        return np.asarray(q)[7:]
+
+    def frame_pose(self, q: np.ndarray, frame: str) -> np.ndarray:
+        """T_world_frame (4, 4) at configuration ``q``."""
+        fid = self.model.getFrameId(frame)
+        pin.framesForwardKinematics(self.model, self.data, q)
+        return self.data.oMf[fid].homogeneous.copy()
+
+    def com(self, q: np.ndarray) -> np.ndarray:
+        return pin.centerOfMass(self.model, self.data, q).copy()
+
+    def joint_distance(self, qa: np.ndarray, qb: np.ndarray) -> float:
+        """Largest joint-angle difference [rad] (the base is implied by the contacts)."""
+        return float(np.max(np.abs(qa[7:] - qb[7:])))
+
+    def interpolate(self, qa: np.ndarray, qb: np.ndarray, s: float) -> np.ndarray:
+        return pin.interpolate(self.model, qa, qb, s)

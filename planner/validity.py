@@ -1,0 +1,108 @@
+"""Is a configuration feasible at a stance? Joint limits, collisions, static stability.
+
+The one predicate every stage of the search and the interpolation uses (thesis §6.3.1):
+every contact meets its hold, the joints are within limits, nothing collides with the
+environment or the robot itself, and the pose is statically stable (CoM inside the
+stance's support region and joint torques within limits).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from planner.collision import CollisionModel
+from planner.contacts import Stance
+from planner.kinematics import HuboKinematics
+from planner.stability import (
+    SupportRegion,
+    check_stability,
+    support_region,
+    torque_limits_by_joint,
+)
+
+#: Tolerance on the joint limits [rad] (placo's QP meets them to solver precision).
+LIMIT_TOL_RAD = 1e-6
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """Why a configuration is or is not feasible, with the figures the plan reports."""
+
+    ok: bool
+    reason: str
+    com_margin_m: float
+    torque_ratio: float
+    clearance_m: float = float("nan")
+    environment_only: bool = False  # the only problem is a collision with the ladder/floor
+
+    def __bool__(self) -> bool:
+        return self.ok
+
+
+class FeasibilityChecker:
+    """Caches the support region per stance and checks configurations against it."""
+
+    def __init__(self, kin: HuboKinematics, collision: CollisionModel,
+                 min_margin_m: float = 0.0):
+        self.kin = kin
+        self.collision = collision
+        self.min_margin_m = min_margin_m
+        self.torque_max = torque_limits_by_joint(kin.params.name)
+        self._regions: dict[tuple, SupportRegion] = {}
+        lower, upper = kin.model.lowerPositionLimit[7:], kin.model.upperPositionLimit[7:]
+        self._lower, self._upper = lower.copy(), upper.copy()
+        self.frame_ids = {limb: kin.model.getFrameId(frame) for limb, frame in
+                          (("left_hand", "L_palm"), ("right_hand", "R_palm"),
+                           ("left_foot", "L_sole"), ("right_foot", "R_sole"))}
+
+    @staticmethod
+    def stance_key(stance: Stance) -> tuple:
+        return tuple(sorted((h.limb, h.target, tuple(np.round(h.T_world_frame[:3, 3], 6)))
+                            for h in stance.holds))
+
+    def region(self, stance: Stance) -> SupportRegion:
+        key = self.stance_key(stance)
+        if key not in self._regions:
+            self._regions[key] = support_region(stance, self.kin.params.total_mass_kg)
+        return self._regions[key]
+
+    def check(self, q: np.ndarray, stance: Stance, contacts: dict[str, str]) -> Verdict:
+        """Feasibility of ``q`` when ``stance`` carries the robot.
+
+        Args:
+            q: configuration.
+            stance: the holds that bear load (stability is tested against them).
+            contacts: limb → environment object it may touch (its held object, and for a
+                moving limb at the ends of its path the object it leaves or reaches).
+        """
+        joints = q[7:]
+        if np.any(joints < self._lower - LIMIT_TOL_RAD) or np.any(joints > self._upper +
+                                                                 LIMIT_TOL_RAD):
+            return Verdict(False, "joint limits", np.nan, np.nan)
+        self.collision.allow(contacts)
+        if self.collision.in_collision(q):
+            pairs = self.collision.colliding_pairs(q)
+            env = set(self.collision.env_names)
+            env_only = all(a.split("/")[0] in env or b.split("/")[0] in env for a, b in pairs)
+            return Verdict(False, f"collision {pairs[0][0]}–{pairs[0][1]}" if pairs else
+                           "collision", np.nan, np.nan, environment_only=env_only)
+        region = self.region(stance)
+        if region.is_empty:
+            return Verdict(False, "stance cannot balance gravity", -np.inf, np.inf)
+        report = check_stability(self.kin.model, self.kin.data, q, stance, region,
+                                 self.torque_max, min_margin_m=self.min_margin_m,
+                                 frame_ids=self.frame_ids)
+        ratio = report.torque.max_ratio if report.torque is not None else np.inf
+        if not report.stable:
+            why = (f"CoM {report.margin_m * 100:.1f} cm outside the support region"
+                   if report.torque is None else
+                   f"torque {ratio:.2f}× limit at {report.torque.worst_joint}")
+            return Verdict(False, why, report.margin_m, ratio)
+        return Verdict(True, "ok", report.margin_m, ratio)
+
+    def clearance(self, q: np.ndarray, contacts: dict[str, str]) -> float:
+        """Smallest distance over the active collision pairs [m] (slower: for reports)."""
+        self.collision.allow(contacts)
+        return self.collision.report(q).min_distance_m

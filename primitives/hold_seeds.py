@@ -1,0 +1,68 @@
+"""Seed holds: where a limb should hold, relative to the ladder's rungs and rails.
+
+A seed is a small descriptor, not a pose: the planner turns it into a `Hold` on a given
+ladder, so one primitive adapts to every ladder. Offsets are in the ladder frame L.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+#: Lateral offset of each sole centre from the ladder centreline [m] (about hip width).
+FOOT_LATERAL_M = 0.11
+#: Sole centre relative to the rung's tread centre, along x_L [m]: the tread under the
+#: middle of the foot, where the ankle torque is smallest.
+FOOT_ALONG_M = 0.0
+
+
+@dataclass(frozen=True)
+class FloorSeed:
+    """A foot flat on the floor where it stands at the start."""
+
+    limb: str
+
+    @property
+    def target(self) -> str:
+        return "floor"
+
+
+@dataclass(frozen=True)
+class RungSeed:
+    """A foot flat on rung ``rung`` (0-based), ``lateral_m`` off centre, ``along_m`` up-ladder."""
+
+    limb: str
+    rung: int
+    lateral_m: float
+    along_m: float = FOOT_ALONG_M
+
+    @property
+    def target(self) -> str:
+        return f"rung_{self.rung}"
+
+
+@dataclass(frozen=True)
+class RailSeed:
+    """A palm closed on the ``side`` rail, at the rail point vertically above rung ``rung``
+    (``rung`` may be one past the top rung: the rail extends that far), shifted
+    ``along_m`` up the rail."""
+
+    limb: str
+    side: str
+    rung: int
+    along_m: float = 0.0
+
+    @property
+    def target(self) -> str:
+        return f"rail_{self.side}"
+
+
+HoldSeed = FloorSeed | RungSeed | RailSeed
+
+
+def foot_on_rung(limb: str, rung: int) -> RungSeed:
+    lateral = FOOT_LATERAL_M if limb == "left_foot" else -FOOT_LATERAL_M
+    return RungSeed(limb, rung, lateral)
+
+
+def hand_on_rail(limb: str, rung: int) -> RailSeed:
+    return RailSeed(limb, "left" if limb == "left_hand" else "right", rung)

@@ -1,0 +1,53 @@
+"""The primitive library and the climbing sequence built from it.
+
+Mount: placeHands, placeLFoot, placeRFoot (feet onto rung 0). Then per rung the executed
+cycle of the thesis: left hand up, right hand up, left foot up, right foot up, straighten.
+Hands hold the rail above the rung the feet stand on; before the feet step to rung k+1
+both hands move to the rail above rung k+1.
+"""
+
+from __future__ import annotations
+
+from primitives.hold_seeds import foot_on_rung, hand_on_rail
+from primitives.primitive import Primitive, Step
+
+# Seed postures [rad]: arms reaching forward and out to the rails with bent elbows, legs
+# bent (a straight knee is a kinematic singularity), fingers set by the planner.
+_ARMS = {"LSP": -0.6, "RSP": -0.6, "LSR": 0.5, "RSR": -0.5, "LEB": -1.0, "REB": -1.0}
+_CROUCH = {"LHP": -0.7, "RHP": -0.7, "LKN": 1.3, "RKN": 1.3, "LAP": -0.6, "RAP": -0.6}
+_STAND = {"LHP": -0.35, "RHP": -0.35, "LKN": 0.6, "RKN": 0.6, "LAP": -0.25, "RAP": -0.25}
+
+PLACE_HANDS = Primitive("placeHands", ("left_hand", "right_hand"), {**_ARMS, **_STAND},
+                        pelvis_offset_m=(-0.15, 0.0, 0.90))
+PLACE_L_FOOT = Primitive("placeLFoot", ("left_foot",), {**_ARMS, **_CROUCH})
+PLACE_R_FOOT = Primitive("placeRFoot", ("right_foot",), {**_ARMS, **_CROUCH})
+MOVE_L_HAND = Primitive("moveLHand", ("left_hand",), {**_ARMS, **_STAND})
+MOVE_R_HAND = Primitive("moveRHand", ("right_hand",), {**_ARMS, **_STAND})
+MOVE_L_FOOT = Primitive("moveLFoot", ("left_foot",), {**_ARMS, **_CROUCH})
+MOVE_R_FOOT = Primitive("moveRFoot", ("right_foot",), {**_ARMS, **_CROUCH})
+#: Straighten the legs with every hold kept: the body rises over the new rung.
+STRAIGHTEN = Primitive("straighten", (), {**_ARMS, **_STAND}, pelvis_offset_m=(-0.2, 0.0, 0.85))
+
+PRIMITIVES = {p.name: p for p in (PLACE_HANDS, PLACE_L_FOOT, PLACE_R_FOOT, MOVE_L_HAND,
+                                  MOVE_R_HAND, MOVE_L_FOOT, MOVE_R_FOOT, STRAIGHTEN)}
+
+
+def climb_sequence(top_rung: int) -> list[Step]:
+    """Every step from standing on the floor to both feet on rung ``top_rung``."""
+    if top_rung < 0:
+        raise ValueError(f"top rung must be ≥ 0, got {top_rung}")
+    steps = [
+        Step(PLACE_HANDS, (hand_on_rail("left_hand", 0), hand_on_rail("right_hand", 0)), 0),
+        Step(PLACE_L_FOOT, (foot_on_rung("left_foot", 0),), 0),
+        Step(PLACE_R_FOOT, (foot_on_rung("right_foot", 0),), 0),
+        Step(STRAIGHTEN, (), 0),
+    ]
+    for k in range(top_rung):
+        steps += [
+            Step(MOVE_L_HAND, (hand_on_rail("left_hand", k + 1),), k),
+            Step(MOVE_R_HAND, (hand_on_rail("right_hand", k + 1),), k),
+            Step(MOVE_L_FOOT, (foot_on_rung("left_foot", k + 1),), k + 1),
+            Step(MOVE_R_FOOT, (foot_on_rung("right_foot", k + 1),), k + 1),
+            Step(STRAIGHTEN, (), k + 1),
+        ]
+    return steps

@@ -1,0 +1,179 @@
+"""The ``*.plan.json`` sidecar of a trajectory: which limbs hold what on every line.
+
+Written by ``plan-ladder``, read by ``validate-plan``, ``play-trajectory`` and
+``check-plan``. Line numbers are 1-based and inclusive, like the trajectory file's.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any
+
+from robot.errors import InputError
+from robot.joints import JOINT_NAMES
+
+FORMAT = "hubo-ladder-plan"
+VERSION = 1
+ARM_MODES = ("position", "pwm")
+LIMBS = ("left_hand", "right_hand", "left_foot", "right_foot")
+
+
+class SidecarError(InputError):
+    """A plan sidecar is malformed."""
+
+
+@dataclass(frozen=True)
+class HoldRecord:
+    """One hold in contact: what it holds and where the limb frame must be [m]."""
+
+    target: str  # "floor", "rung_3", "rail_left", ...
+    position_m: tuple[float, float, float]
+
+
+@dataclass(frozen=True)
+class Segment:
+    """A stretch of lines produced by one primitive (or one phase of it).
+
+    Attributes:
+        primitive: thesis primitive name (``moveLHand`` ...), or ``dwell``.
+        phase: ``body`` (every hold kept), ``limb`` (moving limbs in the air),
+            ``grasp``/``release`` (fingers closing/opening) or ``dwell``.
+        rung: rung the feet stand on or step to.
+        first_line, last_line: 1-based inclusive lines.
+        holds: limb → hold kept in contact during the segment.
+        moving_limbs: limbs in the air.
+    """
+
+    primitive: str
+    phase: str
+    rung: int
+    first_line: int
+    last_line: int
+    holds: dict[str, HoldRecord]
+    moving_limbs: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class PlanSidecar:
+    robot: str
+    ladder: dict[str, Any]  # the full ladder spec, as in its YAML file
+    rate_hz: float
+    line_count: int
+    segments: tuple[Segment, ...]
+    arm_modes: dict[str, list[tuple[int, int, str]]]  # "left"/"right" → runs
+    final_holds: dict[str, HoldRecord]
+    seed: int = 0
+    metrics: dict[str, Any] = field(default_factory=dict)
+    timings_s: dict[str, float] = field(default_factory=dict)
+    planner_version: str = ""
+    joint_order: tuple[str, ...] = JOINT_NAMES
+
+    def segment_at(self, line: int) -> Segment:
+        for seg in self.segments:
+            if seg.first_line <= line <= seg.last_line:
+                return seg
+        raise KeyError(line)
+
+    def to_json(self) -> dict[str, Any]:
+        d = asdict(self)
+        d = {"format": FORMAT, "version": VERSION, **d}
+        d["joint_order"] = list(self.joint_order)
+        return d
+
+
+def sidecar_path(traj_path: str | os.PathLike) -> Path:
+    """``climb.traj`` → ``climb.plan.json``."""
+    p = Path(traj_path)
+    return p.with_name(p.stem + ".plan.json") if p.suffix == ".traj" else \
+        p.with_name(p.name + ".plan.json")
+
+
+def write_sidecar(path: str | os.PathLike, sidecar: PlanSidecar) -> None:
+    path = Path(path)
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(json.dumps(sidecar.to_json(), indent=1))
+    tmp.replace(path)
+
+
+def _hold(d: Any, where: str) -> HoldRecord:
+    if not isinstance(d, dict) or set(d) != {"target", "position_m"}:
+        raise SidecarError(f"{where}: a hold needs exactly 'target' and 'position_m'")
+    pos = d["position_m"]
+    if not (isinstance(pos, list) and len(pos) == 3 and all(isinstance(v, int | float)
+                                                           for v in pos)):
+        raise SidecarError(f"{where}.position_m: expected 3 numbers [m], got {pos!r}")
+    return HoldRecord(str(d["target"]), tuple(float(v) for v in pos))
+
+
+def _holds(d: Any, where: str) -> dict[str, HoldRecord]:
+    if not isinstance(d, dict):
+        raise SidecarError(f"{where}: expected a mapping limb → hold")
+    for limb in d:
+        if limb not in LIMBS:
+            raise SidecarError(f"{where}: unknown limb {limb!r}; limbs are {', '.join(LIMBS)}")
+    return {limb: _hold(h, f"{where}.{limb}") for limb, h in d.items()}
+
+
+def _runs(runs: Any, where: str, line_count: int) -> list[tuple[int, int, str]]:
+    if not isinstance(runs, list) or not runs:
+        raise SidecarError(f"{where}: expected a non-empty list of [first, last, mode] runs")
+    out, expect = [], 1
+    for i, run in enumerate(runs):
+        ok = isinstance(run, list) and len(run) == 3 and isinstance(run[0], int) and \
+            isinstance(run[1], int) and run[2] in ARM_MODES
+        if not ok:
+            raise SidecarError(f"{where}[{i}]: expected [first_line, last_line, "
+                               f"'position'|'pwm'], got {run!r}")
+        if run[0] != expect or run[1] < run[0]:
+            raise SidecarError(f"{where}[{i}]: runs must cover lines 1..{line_count} in "
+                               f"order without gaps; expected a run starting at {expect}")
+        out.append((run[0], run[1], run[2]))
+        expect = run[1] + 1
+    if expect != line_count + 1:
+        raise SidecarError(f"{where}: runs end at line {expect - 1}, the file has {line_count}")
+    return out
+
+
+def read_sidecar(path: str | os.PathLike) -> PlanSidecar:
+    """Read and validate a sidecar. Raises `SidecarError` naming the file and the field."""
+    path = Path(path)
+    try:
+        d = json.loads(path.read_text())
+    except OSError as exc:
+        raise SidecarError(f"{path}: cannot read: {exc.strerror}") from None
+    except json.JSONDecodeError as exc:
+        raise SidecarError(f"{path}:{exc.lineno}:{exc.colno}: invalid JSON: {exc.msg}") from None
+    if not isinstance(d, dict) or d.get("format") != FORMAT:
+        raise SidecarError(f"{path}: not a {FORMAT} file (field 'format')")
+    if d.get("version") != VERSION:
+        raise SidecarError(f"{path}: field 'version' is {d.get('version')!r}; this reader "
+                           f"reads version {VERSION}")
+    try:
+        n = int(d["line_count"])
+        if tuple(d["joint_order"]) != JOINT_NAMES:
+            raise SidecarError(f"{path}: field 'joint_order' is not the 40-column order")
+        segments = []
+        for i, s in enumerate(d["segments"]):
+            where = f"{path}: segments[{i}]"
+            if not 1 <= s["first_line"] <= s["last_line"] <= n:
+                raise SidecarError(f"{where}: lines {s['first_line']}..{s['last_line']} are "
+                                   f"outside 1..{n}")
+            segments.append(Segment(s["primitive"], s["phase"], int(s["rung"]),
+                                    int(s["first_line"]), int(s["last_line"]),
+                                    _holds(s["holds"], f"{where}.holds"),
+                                    tuple(s.get("moving_limbs", ()))))
+        arm_modes = {arm: _runs(d["arm_modes"].get(arm), f"{path}: arm_modes.{arm}", n)
+                     for arm in ("left", "right")}
+        return PlanSidecar(
+            robot=d["robot"], ladder=d["ladder"], rate_hz=float(d["rate_hz"]), line_count=n,
+            segments=tuple(segments), arm_modes=arm_modes,
+            final_holds=_holds(d["final_holds"], f"{path}: final_holds"),
+            seed=int(d.get("seed", 0)), metrics=d.get("metrics", {}),
+            timings_s=d.get("timings_s", {}), planner_version=d.get("planner_version", ""))
+    except KeyError as exc:
+        raise SidecarError(f"{path}: missing field {exc.args[0]!r}") from None
+    except (TypeError, ValueError) as exc:
+        raise SidecarError(f"{path}: malformed field: {exc}") from None
