@@ -1,0 +1,312 @@
+"""The grasp latch: a hand closed on a rail holds it, within what the grip can carry.
+
+MuJoCo friction alone cannot keep a five-finger hook grip on a round rail (library notes:
+a hand slid metres with default cones), and a real Hubo hand holds by closure rather
+than by friction alone. So a closed hand is *latched* to the ladder by a weld equality
+(one per hand, added to the spec inactive and switched through ``data.eq_active``), made
+at the hand's pose relative to the ladder at the moment it latches.
+
+When it latches (all of):
+
+- the fingers are commanded closed (sent reference ≥ ``closed_fraction`` ·
+  ``FINGER_CLOSED_RAD``) and are closed (measured mean curl at least that). The board
+  model keeps fingers from colliding with the rails (their capsules' curl sweeps through
+  the grip centre): the grip is this latch, not finger contact;
+- the hand was open before (a fist that closed on nothing does not grasp a rail it
+  meets later: it must open first);
+- its palm site (the grip centre) is within ``position_tolerance_m`` of a rail axis and
+  its grip axis (palm x) within ``angle_tolerance_rad`` of the rail direction (either
+  sense: the hand is symmetric along x).
+
+When it lets go:
+
+- the fingers are commanded open (sent reference below ``open_fraction`` · closed);
+- the finger board tripped (no finger torque, no grip);
+- the weld's load exceeds the grip's capacity for ``slip_persistence_s`` (a slip).
+
+Grip capacity, from the fingers' torque limit (hubo-facts §5: ≈ 5 N·m each):
+
+======================  ================================  ========================
+load on the hand        capacity                          DRC-Hubo, μ = 0.4
+======================  ================================  ========================
+radial force            ``N = n·τ_f / ℓ``                 5·5/0.06 = 417 N
+force along the rail    ``2μ·N`` (fingers + palm rub)     333 N
+torque about the rail   ``2μ·N·r_rail``                   8.3 N·m (r = 25 mm)
+bending torque          ``(τ_f/ℓ)·Σ|x_i|`` (finger couple)  9.0 N·m
+======================  ================================  ========================
+
+``ℓ = 0.06 m`` is the finger-joint-to-rail-axis lever at the grip centre (finger joints
+4.5 cm above and 4 cm beside it: ``√(0.045² + 0.04²)``), ``x_i`` the finger positions
+along the grip axis (±36, ±18, 0 mm), ``μ`` the ladder's friction. The load is the
+weld's constraint wrench on the hand, about the palm site, split along and across the
+rail. ``slip_persistence_s = 10 ms`` (two ticks) only filters single-step constraint
+spikes at impacts; it is not a tuning knob.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from enum import Enum
+
+import mujoco
+import numpy as np
+
+from robot.kinematic_tree import FINGER_CLOSED_RAD
+
+__all__ = ["GraspEvent", "GraspLatch", "GripCapacity", "GripConfig", "GripState"]
+
+#: Finger positions along the grip axis [m] (robot.kinematic_tree: −0.036 + 0.018·i).
+FINGER_X_M = (-0.036, -0.018, 0.0, 0.018, 0.036)
+
+
+@dataclass(frozen=True)
+class GripConfig:
+    """Latch thresholds (see the module docstring).
+
+    Attributes:
+        closed_fraction: share of ``FINGER_CLOSED_RAD`` at which fingers count closed.
+        open_fraction: share of it below which a commanded opening releases.
+        position_tolerance_m: palm site to rail axis [m].
+        angle_tolerance_rad: grip axis to rail direction [rad].
+        finger_torque_nm: torque limit of one finger [N·m].
+        finger_lever_m: finger joint to rail axis at the grip centre [m].
+        slip_persistence_s: how long an overload must last to release [s].
+    """
+
+    closed_fraction: float = 0.8
+    open_fraction: float = 0.5
+    position_tolerance_m: float = 0.02
+    angle_tolerance_rad: float = math.radians(20.0)
+    finger_torque_nm: float = 5.0
+    finger_lever_m: float = 0.06
+    slip_persistence_s: float = 0.01
+
+
+@dataclass(frozen=True)
+class GripCapacity:
+    """What a closed hand can carry on a rail (module docstring table)."""
+
+    radial_n: float
+    axial_n: float
+    roll_nm: float
+    bending_nm: float
+
+    @classmethod
+    def of(cls, cfg: GripConfig, friction: float, rail_radius_m: float,
+           finger_torque_nm: float | None = None) -> GripCapacity:
+        tau = cfg.finger_torque_nm if finger_torque_nm is None else finger_torque_nm
+        per_finger = tau / cfg.finger_lever_m
+        n = per_finger * len(FINGER_X_M)
+        return cls(n, 2 * friction * n, 2 * friction * n * rail_radius_m,
+                   per_finger * sum(abs(x) for x in FINGER_X_M))
+
+    def utilisation(self, force_n: np.ndarray, torque_nm: np.ndarray,
+                    axis: np.ndarray) -> tuple[float, str]:
+        """Largest load / capacity ratio and which component it is."""
+        fa = float(force_n @ axis)
+        ta = float(torque_nm @ axis)
+        parts = {
+            "radial force": np.linalg.norm(force_n - fa * axis) / self.radial_n,
+            "force along the rail": abs(fa) / self.axial_n,
+            "torque about the rail": abs(ta) / self.roll_nm,
+            "bending torque": np.linalg.norm(torque_nm - ta * axis) / self.bending_nm,
+        }
+        name = max(parts, key=parts.get)
+        return float(parts[name]), name
+
+
+class GripState(Enum):
+    OPEN = "open"
+    LATCHED = "latched"
+    CLOSED_EMPTY = "closed on nothing"
+
+
+@dataclass(frozen=True)
+class GraspEvent:
+    """A change of a hand's grip: ``latched`` / ``released`` / ``missed``."""
+
+    hand: str  # "left" / "right"
+    kind: str
+    time_s: float
+    rail: str | None
+    reason: str
+    distance_m: float | None = None  # palm to nearest rail axis at the event
+    angle_rad: float | None = None
+
+    def __str__(self) -> str:
+        where = f" rail {self.rail}" if self.rail else ""
+        return f"{self.hand} hand {self.kind}{where} at t = {self.time_s:.2f} s: {self.reason}"
+
+
+def _segment_closest(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    d = b - a
+    t = float(np.clip((p - a) @ d / (d @ d), 0.0, 1.0))
+    return a + t * d
+
+
+class GraspLatch:
+    """The latch of one hand (see the module docstring).
+
+    Args:
+        model, data: the compiled scene and its data.
+        hand: ``"left"`` or ``"right"``.
+        eq_id: id of the hand's (inactive) weld equality, hand body ↔ ladder body.
+        finger_qpos: qpos addresses of the hand's five finger joints.
+        finger_cols: their columns in the 40-column order.
+        rails: rail name → (p0 site id, p1 site id, geom id).
+        friction: ladder friction μ [-].
+        rail_radius_m: rail radius [m].
+        config: thresholds.
+    """
+
+    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, hand: str, eq_id: int,
+                 finger_qpos: np.ndarray, finger_cols: np.ndarray,
+                 rails: dict[str, tuple[int, int, int]], friction: float,
+                 rail_radius_m: float, config: GripConfig | None = None):
+        self.model, self.data, self.hand = model, data, hand
+        self.config = config or GripConfig()
+        self.eq_id = eq_id
+        side = "L" if hand == "left" else "R"
+        self.body_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, f"{side}_hand")
+        self.palm_site = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, f"{side}_palm")
+        self.ladder_body = int(model.eq_obj2id[eq_id])
+        self.finger_qpos = np.asarray(finger_qpos)
+        self.finger_cols = np.asarray(finger_cols)
+        self.rails = rails
+        self.friction, self.rail_radius_m = friction, rail_radius_m
+        self.capacity = GripCapacity.of(self.config, friction, rail_radius_m)
+        self._jacp = np.zeros((3, model.nv))
+        self._jacr = np.zeros((3, model.nv))
+        self._qfrc = np.zeros(model.nv)
+        self.reset()
+
+    # ------------------------------------------------------------------ state
+    def reset(self) -> None:
+        """Open hand, weld off."""
+        self.state = GripState.OPEN
+        self.rail: str | None = None
+        self._overload_s = 0.0
+        self.peak_utilisation = 0.0
+        self.last_utilisation = (0.0, "")
+        self.data.eq_active[self.eq_id] = 0
+
+    @property
+    def latched(self) -> bool:
+        return self.state is GripState.LATCHED
+
+    def palm_to_rails(self) -> dict[str, tuple[float, float]]:
+        """Rail → (distance of the palm site from its axis [m], grip-axis angle [rad])."""
+        p = self.data.site_xpos[self.palm_site]
+        x = self.data.site_xmat[self.palm_site].reshape(3, 3)[:, 0]
+        out = {}
+        for name, (s0, s1, _g) in self.rails.items():
+            a, b = self.data.site_xpos[s0], self.data.site_xpos[s1]
+            axis = (b - a) / np.linalg.norm(b - a)
+            dist = float(np.linalg.norm(p - _segment_closest(p, a, b)))
+            ang = math.acos(min(1.0, abs(float(x @ axis))))
+            out[name] = (dist, ang)
+        return out
+
+    def grip_load(self) -> tuple[np.ndarray, np.ndarray]:
+        """Weld wrench on the hand about the palm site: force [N], torque [N·m] (world)."""
+        m, d = self.model, self.data
+        n = d.nefc
+        rows = (d.efc_type[:n] == mujoco.mjtConstraint.mjCNSTR_EQUALITY) & \
+            (d.efc_id[:n] == self.eq_id)
+        if not rows.any():
+            return np.zeros(3), np.zeros(3)
+        f = np.where(rows, d.efc_force[:n], 0.0)
+        mujoco.mj_mulJacTVec(m, d, self._qfrc, f)
+        mujoco.mj_jac(m, d, self._jacp, self._jacr, d.site_xpos[self.palm_site], self.body_id)
+        J = np.vstack([self._jacp, self._jacr])
+        w = np.linalg.lstsq(J.T, self._qfrc, rcond=None)[0]
+        return w[:3], w[3:]
+
+    # ------------------------------------------------------------------ update
+    def update(self, time_s: float, dt_s: float, finger_ref_rad: np.ndarray,
+               finger_board_ok: bool) -> GraspEvent | None:
+        """One check after a tick. ``finger_ref_rad`` is the sent finger reference (5,)."""
+        cfg = self.config
+        closed_ref = float(np.mean(finger_ref_rad)) >= cfg.closed_fraction * FINGER_CLOSED_RAD
+        opening = float(np.mean(finger_ref_rad)) < cfg.open_fraction * FINGER_CLOSED_RAD
+        curl = float(np.mean(self.data.qpos[self.finger_qpos]))
+        if self.state is GripState.LATCHED:
+            if not finger_board_ok:
+                return self._release(time_s, "its finger board tripped: no finger torque, "
+                                              "the fingers let go", GripState.CLOSED_EMPTY)
+            if opening:
+                return self._release(time_s, "fingers commanded open", GripState.OPEN)
+            force, torque = self.grip_load()
+            axis = self._rail_axis(self.rail)
+            self.last_utilisation = self.capacity.utilisation(force, torque, axis)
+            u, what = self.last_utilisation
+            self.peak_utilisation = max(self.peak_utilisation, u)
+            self._overload_s = self._overload_s + dt_s if u > 1.0 else 0.0
+            if self._overload_s >= cfg.slip_persistence_s - 1e-12:
+                return self._release(time_s, f"{what} {u:.2f}× what the grip holds "
+                                              f"(|F| = {np.linalg.norm(force):.0f} N, "
+                                              f"|T| = {np.linalg.norm(torque):.1f} N·m)",
+                                     GripState.CLOSED_EMPTY)
+            return None
+        if self.state is GripState.CLOSED_EMPTY:
+            if opening and curl < cfg.open_fraction * FINGER_CLOSED_RAD:
+                self.state = GripState.OPEN
+            return None
+        # OPEN
+        if not (closed_ref and finger_board_ok):
+            return None
+        near = self.palm_to_rails()
+        rail = min(near, key=lambda r: near[r][0])
+        dist, ang = near[rail]
+        if curl < cfg.closed_fraction * FINGER_CLOSED_RAD:
+            return None  # still closing
+        if dist <= cfg.position_tolerance_m and ang <= cfg.angle_tolerance_rad:
+            self._latch(rail)
+            return GraspEvent(self.hand, "latched", time_s, rail,
+                              f"palm {dist * 100:.1f} cm from the axis, grip axis "
+                              f"{math.degrees(ang):.0f}° off", dist, ang)
+        self.state = GripState.CLOSED_EMPTY
+        why = []
+        if dist > cfg.position_tolerance_m:
+            why.append(f"palm {dist * 100:.1f} cm from the {rail} axis (tolerance "
+                       f"{cfg.position_tolerance_m * 100:.0f} cm)")
+        if ang > cfg.angle_tolerance_rad:
+            why.append(f"grip axis {math.degrees(ang):.0f}° off the rail (tolerance "
+                       f"{math.degrees(cfg.angle_tolerance_rad):.0f}°)")
+        return GraspEvent(self.hand, "missed", time_s, rail,
+                          "fingers closed on nothing: " + "; ".join(why), dist, ang)
+
+    def _rail_axis(self, rail: str) -> np.ndarray:
+        s0, s1, _ = self.rails[rail]
+        d = self.data.site_xpos[s1] - self.data.site_xpos[s0]
+        return d / np.linalg.norm(d)
+
+    def _latch(self, rail: str) -> None:
+        """Weld hand ↔ ladder at their current relative pose."""
+        m, d = self.model, self.data
+        h, lad = self.body_id, self.ladder_body
+        p = d.site_xpos[self.palm_site]
+        R_h = d.xmat[h].reshape(3, 3)
+        R_l = d.xmat[lad].reshape(3, 3)
+        eq = m.eq_data[self.eq_id]
+        eq[0:3] = R_l.T @ (p - d.xpos[lad])  # anchor in the ladder (body2) frame
+        eq[3:6] = R_h.T @ (p - d.xpos[h])  # the same point in the hand (body1) frame
+        q = np.zeros(4)
+        neg = np.zeros(4)
+        mujoco.mju_negQuat(neg, d.xquat[h])
+        mujoco.mju_mulQuat(q, neg, d.xquat[lad])  # relpose: q_ladder = q_hand · relpose
+        eq[6:10] = q
+        eq[10] = 1.0  # torquescale
+        d.eq_active[self.eq_id] = 1
+        self.state = GripState.LATCHED
+        self.rail = rail
+        self._overload_s = 0.0
+
+    def _release(self, time_s: float, reason: str, new_state: GripState) -> GraspEvent:
+        rail = self.rail
+        self.data.eq_active[self.eq_id] = 0
+        self.state = new_state
+        self.rail = None
+        self._overload_s = 0.0
+        return GraspEvent(self.hand, "released", time_s, rail, reason)
