@@ -1,0 +1,236 @@
+"""Latest-value channels: in-process and between real processes (shared memory)."""
+
+from __future__ import annotations
+
+import gc
+import multiprocessing as mp
+import os
+import signal
+import struct
+import threading
+import time
+
+import numpy as np
+import pytest
+
+from daemon import channels as ch
+from daemon.channels import (
+    ChannelError,
+    InProcessChannel,
+    ShmChannel,
+    channel_path,
+    cleanup_stale,
+    open_channel,
+    reset_in_process,
+)
+from daemon.structs import REF_DTYPE, STATE_DTYPE, new_sample
+
+CTX = mp.get_context("spawn")
+
+
+@pytest.fixture()
+def instance(request):
+    name = f"t{os.getpid()}-{request.node.name[:20]}".replace("[", "-").replace("]", "")
+    name = "".join(c for c in name if c.isalnum() or c in "-_")[:40]
+    yield name
+    reset_in_process(name)
+    gc.collect()  # channels a failed test left open
+    cleanup_stale(name)
+
+
+def _ref(value: float) -> np.ndarray:
+    s = new_sample(REF_DTYPE)
+    s["ref"][:] = value
+    return s
+
+
+# ---------------------------------------------------------------- child processes
+
+
+def _child_write(instance: str, values: list[float], delay_s: float, writer_id: int) -> None:
+    c = ShmChannel("ref", instance, writer_id=writer_id)
+    time.sleep(delay_s)
+    for v in values:
+        c.write(_ref(v))
+    c.close()
+
+
+def _child_write_forever(instance: str, started) -> None:
+    c = ShmChannel("ref", instance, writer_id=66)
+    k = 0
+    while True:
+        c.write(_ref(float(k)))
+        if k == 10:
+            started.set()
+        k += 1
+
+
+def _child_wait(instance: str, last: int, out) -> None:
+    c = ShmChannel("ref", instance)
+    s = c.wait_newer(last, 5.0)
+    out.put(None if s is None else float(s["ref"][0]))
+    c.close()
+
+
+def _run(target, *args):
+    p = CTX.Process(target=target, args=args, daemon=True)
+    p.start()
+    return p
+
+
+# ---------------------------------------------------------------- both implementations
+
+
+@pytest.mark.parametrize("in_process", [True, False], ids=["inproc", "shm"])
+def test_latest_value_semantics(instance, in_process):
+    a = open_channel("ref", instance, writer_id=1, in_process=in_process)
+    b = open_channel("ref", instance, writer_id=2, in_process=in_process)
+    assert b.read_latest() is None
+    t1 = a.write(_ref(1.0))
+    a.write(_ref(2.0))
+    got = b.read_latest()
+    assert float(got["ref"][5]) == 2.0 and int(got["writer_id"]) == 1 and int(got["seq"]) == 2
+    assert int(got["time_ns"]) > t1
+    b.write(_ref(3.0))  # the newest, from another writer
+    assert float(a.read_latest()["ref"][0]) == 3.0
+    assert int(a.read_latest()["writer_id"]) == 2
+    got["ref"][0] = 99.0  # a copy: changing it changes nothing on the channel
+    assert float(a.read_latest()["ref"][0]) == 3.0
+    a.close()
+    b.close()
+
+
+@pytest.mark.parametrize("in_process", [True, False], ids=["inproc", "shm"])
+def test_wait_newer_times_out_and_wakes(instance, in_process):
+    r = open_channel("ref", instance, in_process=in_process)
+    w = open_channel("ref", instance, in_process=in_process)
+    t0 = time.monotonic()
+    assert r.wait_newer(0, 0.05) is None
+    assert 0.04 <= time.monotonic() - t0 < 1.0
+    stamp = w.write(_ref(1.0))
+    assert float(r.wait_newer(0, 0.0)["ref"][0]) == 1.0  # already there: no wait
+    assert r.wait_newer(stamp, 0.0) is None
+    timer = threading.Timer(0.05, lambda: w.write(_ref(2.0)))
+    timer.start()
+    got = r.wait_newer(stamp, 5.0)
+    timer.join()
+    assert got is not None and float(got["ref"][0]) == 2.0
+    r.close()
+    w.close()
+
+
+def test_other_structs_and_errors(instance):
+    c = ShmChannel("state", instance)
+    s = new_sample(STATE_DTYPE)
+    s["imu"]["az"][0] = 9.81
+    s["tick"] = 7
+    c.write(s)
+    got = c.read_latest()
+    assert got.dtype == STATE_DTYPE and float(got["imu"]["az"][0]) == 9.81 and got["tick"] == 7
+    c.close()
+    with pytest.raises(ChannelError, match="instance 'bad/name'"):
+        ShmChannel("ref", "bad/name")
+    with pytest.raises(ChannelError, match="no default struct; known channels"):
+        ShmChannel("nope", instance)
+    with pytest.raises(ChannelError, match="lacks header field"):
+        InProcessChannel("x", instance, dtype=np.dtype([("a", "<f8")]))
+    held = ShmChannel("ref", instance)  # in use with the ref layout
+    with pytest.raises(ChannelError, match="another layout and is in use"):
+        ShmChannel("ref", instance, dtype=STATE_DTYPE)
+    held.close()
+    ShmChannel("ref", instance, dtype=STATE_DTYPE).close()  # unused: re-initialised
+
+
+def test_writer_slots_are_per_object_and_limited(instance):
+    ws = [ShmChannel("ref", instance, writer_id=k) for k in range(ch.MAX_WRITERS)]
+    for k, w in enumerate(ws):
+        w.write(_ref(float(k)))
+    extra = ShmChannel("ref", instance)
+    with pytest.raises(ChannelError, match="writer slots are in use"):
+        extra.write(_ref(0.0))
+    ws[0].close()  # frees its slot
+    extra.write(_ref(42.0))
+    assert float(extra.read_latest()["ref"][0]) == 42.0
+    for w in ws[1:] + [extra]:
+        w.close()
+
+
+def test_torn_slot_of_a_dead_writer_is_skipped_then_reclaimed(instance):
+    w = ShmChannel("ref", instance, writer_id=1)
+    w.write(_ref(1.0))  # slot 0
+    other = ShmChannel("ref", instance, writer_id=2)
+    other.write(_ref(2.0))  # slot 1
+    w.write(_ref(4.0))
+    # Simulate w killed mid-write: its slot's counter stays odd and its lock is gone.
+    r = ShmChannel("ref", instance)
+    struct.pack_into("<q", r._mm, ch._TABLE_OFF, 5)
+    w.close()
+    assert float(r.read_latest()["ref"][0]) == 2.0  # the torn slot is ignored
+    fresh = ShmChannel("ref", instance, writer_id=3)
+    fresh.write(_ref(3.0))  # claims slot 0 and repairs it
+    assert float(r.read_latest()["ref"][0]) == 3.0
+    for c in (other, r, fresh):
+        c.close()
+
+
+# ---------------------------------------------------------------- real processes
+
+
+def test_two_processes_reader_gets_newest_from_two_writers(instance):
+    r = ShmChannel("ref", instance)
+    p1 = _run(_child_write, instance, [1.0, 2.0], 0.0, 11)
+    p1.join(20)
+    p2 = _run(_child_write, instance, [5.0], 0.0, 12)
+    p2.join(20)
+    got = r.read_latest()
+    assert float(got["ref"][0]) == 5.0 and int(got["writer_id"]) == 12
+    p3 = _run(_child_write, instance, [7.0], 0.0, 11)
+    p3.join(20)
+    got = r.read_latest()
+    assert float(got["ref"][0]) == 7.0 and int(got["writer_id"]) == 11
+    assert all(p.exitcode == 0 for p in (p1, p2, p3))
+    r.close()
+
+
+def test_two_processes_blocking_wait(instance):
+    w = ShmChannel("ref", instance)
+    stamp = w.write(_ref(1.0))
+    out = CTX.Queue()
+    p = _run(_child_wait, instance, stamp, out)
+    time.sleep(0.3)  # let the child block
+    w.write(_ref(2.0))
+    assert out.get(timeout=20) == 2.0
+    p.join(20)
+    # ... and a writer in another process wakes a reader here.
+    stamp = w.read_latest()["time_ns"]
+    p = _run(_child_write, instance, [3.0], 0.3, 5)
+    got = w.wait_newer(int(stamp), 20.0)
+    assert got is not None and float(got["ref"][0]) == 3.0
+    p.join(20)
+    w.close()
+
+
+def test_sigkilled_writer_then_fresh_start(instance):
+    started = CTX.Event()
+    p = _run(_child_write_forever, instance, started)
+    assert started.wait(20)
+    os.kill(p.pid, signal.SIGKILL)  # possibly mid-write
+    p.join(20)
+    # Nothing blocks the next start: a new writer and reader work at once.
+    p2 = _run(_child_write, instance, [123.0], 0.0, 77)
+    p2.join(20)
+    assert p2.exitcode == 0
+    r = ShmChannel("ref", instance)
+    got = r.wait_newer(0, 1.0)
+    assert got is not None and float(got["ref"][0]) == 123.0
+    r.close()
+    # Nobody uses the channel any more: start-up cleanup removes it.
+    assert channel_path(instance, "ref") in cleanup_stale(instance)
+    assert not channel_path(instance, "ref").exists()
+
+
+def test_cleanup_keeps_channels_in_use(instance):
+    c = ShmChannel("ref", instance)
+    assert cleanup_stale(instance) == []
+    c.close()
+    assert cleanup_stale(instance) == [channel_path(instance, "ref")]
