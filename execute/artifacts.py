@@ -76,7 +76,10 @@ def render_frames(run, times_s, size: tuple[int, int]) -> list[np.ndarray]:
     Raises:
         RenderingUnavailable: no EGL context (message says how to get one).
     """
-    os.environ.setdefault("MUJOCO_GL", "egl")
+    import sys
+
+    if "mujoco" not in sys.modules:
+        os.environ.setdefault("MUJOCO_GL", "egl")
     import mujoco
 
     lg = run.log
@@ -87,10 +90,11 @@ def render_frames(run, times_s, size: tuple[int, int]) -> list[np.ndarray]:
     try:
         renderer = mujoco.Renderer(m, height=size[1], width=size[0])
     except Exception as exc:  # mujoco raises plain RuntimeError/FatalError types
-        raise RenderingUnavailable(
-            f"cannot create an off-screen OpenGL context with MUJOCO_GL="
-            f"{os.environ.get('MUJOCO_GL')!r} ({exc}); install Mesa EGL "
-            "(libegl1, libgl1-mesa-dri) or run on a machine with a GPU driver") from None
+        gl = os.environ.get("MUJOCO_GL")
+        hint = ("set MUJOCO_GL=egl before mujoco is first imported" if gl != "egl" else
+                "install Mesa EGL (libegl1, libgl1-mesa-dri) or use a GPU driver")
+        raise RenderingUnavailable(f"cannot create an off-screen OpenGL context with "
+                                   f"MUJOCO_GL={gl!r} ({exc}); {hint}") from None
     frames = []
     try:
         for t in times_s:

@@ -17,12 +17,13 @@ from __future__ import annotations
 import argparse
 import json
 import logging
+import os
 import sys
 from pathlib import Path
 
 from robot.errors import HuboLadderError, InputError
 
-__all__ = ["main", "result_json"]
+__all__ = ["ladder_from_sidecar", "main", "result_json"]
 
 log = logging.getLogger("validate-plan")
 
@@ -46,7 +47,7 @@ def _parser() -> argparse.ArgumentParser:
     return p
 
 
-def _ladder_from_sidecar(d: dict, where: str):
+def ladder_from_sidecar(d: dict, where: str):
     from ladders.loader import parse_ladder_yaml
     from ladders.spec import LadderSpec
 
@@ -115,7 +116,7 @@ def _run(args: argparse.Namespace) -> int:
     if len(traj) != sidecar.line_count:
         raise InputError(f"{plan}:{len(traj)}: the file has {len(traj)} lines, its sidecar "
                          f"{side} says {sidecar.line_count}")
-    ladder = load_ladder(args.ladder) if args.ladder else _ladder_from_sidecar(
+    ladder = load_ladder(args.ladder) if args.ladder else ladder_from_sidecar(
         sidecar.ladder, f"{side}: ladder")
     board_cfg = BoardModelConfig(battery_v=args.battery)
     opts = SimulationOptions(strategy=args.strategy,
@@ -153,6 +154,8 @@ def main(argv: list[str] | None = None) -> int:
     """Entry point of ``validate-plan``; returns the exit code."""
     parser = _parser()
     args = parser.parse_args(argv)
+    if args.plots or args.video:
+        os.environ.setdefault("MUJOCO_GL", "egl")  # before mujoco is imported
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
                         format="%(name)s: %(message)s")
     try:

@@ -1,0 +1,98 @@
+"""validate-plan: exit codes, the three strategies on the fixture, the result JSON."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+sys.path.insert(0, str(Path(__file__).parent / "fixtures"))
+
+from make_fixture import cached_reach_fixture  # noqa: E402
+
+from execute.validate_cli import main  # noqa: E402
+from robot.plan_sidecar import sidecar_path  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def plan(tmp_path_factory) -> Path:
+    return cached_reach_fixture(tmp_path_factory.getbasetemp())
+
+
+@pytest.fixture(scope="module")
+def results(plan, tmp_path_factory) -> dict[str, dict]:
+    out = tmp_path_factory.mktemp("results")
+    res = {}
+    for strategy in ("mixed", "position", "pwm"):
+        path = out / f"{strategy}.json"
+        code = main([str(plan), "--strategy", strategy, "--json", str(path)])
+        res[strategy] = {"code": code, **json.loads(path.read_text())}
+    return res
+
+
+def test_bad_file_exits_2_with_its_line(plan, tmp_path, capsys):
+    bad = tmp_path / "bad.traj"
+    lines = plan.read_text().splitlines()
+    cols = lines[6].split()
+    cols[3] = "oops"
+    lines[6] = " ".join(cols)
+    bad.write_text("\n".join(lines) + "\n")
+    shutil.copy(sidecar_path(plan), sidecar_path(bad))
+    assert main([str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert f"{bad}:7:" in err and "RKN" in err
+
+
+def test_missing_sidecar_and_bad_options_exit_2(plan, tmp_path, capsys):
+    lone = tmp_path / "lone.traj"
+    shutil.copy(plan, lone)
+    assert main([str(lone)]) == 2
+    assert "sidecar" in capsys.readouterr().err
+    assert main([str(plan), "--placement-error", "1,2"]) == 2
+    assert "placement-error" in capsys.readouterr().err
+    assert main([str(plan), "--battery", "300"]) == 2
+    assert "battery" in capsys.readouterr().err
+
+
+def test_mixed_climbs_the_fixture(results):
+    r = results["mixed"]
+    assert r["code"] == 0 and r["verdict"] == "climbed" and r["cause"] is None
+    assert set(r["final_holds"].values()) == {"ok"}
+    assert any("latched" in e for e in r["grasp_events"])
+    assert r["metrics"]["real_time_factor"] > 0
+
+
+def test_strategies_differ_and_say_why(results):
+    pos, pwm = results["position"], results["pwm"]
+    assert results["mixed"]["code"] == 0
+    # compliant arms cannot lift themselves to the rails (duty clamp, back-EMF)
+    assert pwm["code"] == 1 and pwm["cause"] == "grasp_not_latched"
+    assert "closed on nothing" in pwm["why"] and "cm from the rail axis" in pwm["why"]
+    assert pwm["details"]["palm_to_axis_m"] > 0.02
+    # position and mixed both grasp; the PWM hold phase of mixed tracks worse
+    assert pos["code"] == 0
+    te = {k: v["metrics"]["tracking_error_rad"] for k, v in results.items()}
+    assert te["mixed"]["left"] > 1.5 * te["position"]["left"]
+    for arm in ("left", "right"):
+        assert te["pwm"][arm] >= 10 * te["position"][arm]
+    assert {r["strategy"] for r in results.values()} == {"mixed", "position", "pwm"}
+
+
+def test_plots_written_or_rendering_reported(plan, tmp_path):
+    # a fresh interpreter, so MUJOCO_GL=egl is set before mujoco is imported
+    env = {**os.environ, "MUJOCO_GL": "egl"}
+    out = tmp_path / "p"
+    proc = subprocess.run([sys.executable, "-m", "execute.validate_cli", str(plan),
+                           "--strategy", "position", "--plots", str(out)],
+                          capture_output=True, text=True, env=env, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert (out / "tracking_left.png").stat().st_size > 1000
+    if not (out / "snapshots.png").exists():
+        assert "no rendering" in proc.stderr
+        pytest.skip("EGL rendering unavailable: " + proc.stderr.strip())
+    assert (out / "snapshots.png").stat().st_size > 1000
