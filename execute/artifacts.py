@@ -95,13 +95,15 @@ def render_frames(run, times_s, size: tuple[int, int]) -> list[np.ndarray]:
                 "install Mesa EGL (libegl1, libgl1-mesa-dri) or use a GPU driver")
         raise RenderingUnavailable(f"cannot create an off-screen OpenGL context with "
                                    f"MUJOCO_GL={gl!r} ({exc}); {hint}") from None
+    option = mujoco.MjvOption()
+    option.geomgroup[:] = 1  # the robot's geoms are in group 3 (collision class)
     frames = []
     try:
         for t in times_s:
             k = int(np.clip(np.searchsorted(lg.time_s, t), 0, len(lg.time_s) - 1))
             d.qpos[:] = lg.qpos[k]
             mujoco.mj_forward(m, d)
-            renderer.update_scene(d, camera="side")
+            renderer.update_scene(d, camera="side", scene_option=option)
             frames.append(renderer.render().copy())
     finally:
         renderer.close()

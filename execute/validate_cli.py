@@ -121,8 +121,7 @@ def _run(args: argparse.Namespace) -> int:
     board_cfg = BoardModelConfig(battery_v=args.battery)
     opts = SimulationOptions(strategy=args.strategy,
                              placement=PlacementError.parse(args.placement_error),
-                             board=board_cfg,
-                             record_qpos=bool(args.video or args.plots))
+                             board=board_cfg)
     run = simulate(traj, sidecar, ladder, opts, robot)
     metrics = compute_metrics(run)
     result = result_json(run, metrics, str(plan))

@@ -65,6 +65,7 @@ def test_mixed_climbs_the_fixture(results):
     assert set(r["final_holds"].values()) == {"ok"}
     assert any("latched" in e for e in r["grasp_events"])
     assert r["metrics"]["real_time_factor"] > 0
+    assert 0 < r["metrics"]["min_com_margin_m"] < 0.15  # CoM inside the feet while standing
 
 
 def test_strategies_differ_and_say_why(results):
