@@ -1,8 +1,8 @@
 """Collision checking with coal on the robot's primitive geometry and the ladder.
 
 The robot's capsules and boxes come from the kinematic tree (the same primitives the
-MuJoCo model uses). Self pairs are every pair of links at least three joints apart that
-do not already touch in the zero pose (the usual SRDF rule). Environment pairs are every
+MuJoCo model uses). Self pairs are every pair of links at least two joints apart (with
+co-located joints merged) that do not already touch in the zero pose (the SRDF rule). Environment pairs are every
 robot geometry against the floor and each ladder part; a limb's end links are allowed to
 touch what that limb holds.
 """
@@ -39,17 +39,26 @@ def _shape(g: Geom) -> tuple[coal.CollisionGeometry, np.ndarray]:
 
 
 def _tree_distance(tree: KinematicTree, a: str, b: str) -> int:
-    parents = {lk.name: lk.parent for lk in tree.links}
+    """Bodies between two links along the tree, not counting links without geometry
+    (the small motor links between co-located hip, shoulder, elbow and wrist joints):
+    the thigh is then adjacent to the pelvis, the upper arm to the torso."""
+    by_name = {lk.name: lk for lk in tree.links}
 
-    def chain(x):
+    def chain(x: str) -> list[str]:
         out = [x]
-        while parents[out[-1]] is not None:
-            out.append(parents[out[-1]])
+        while by_name[out[-1]].parent is not None:
+            out.append(by_name[out[-1]].parent)
         return out
 
     ca, cb = chain(a), chain(b)
     common = next(x for x in ca if x in cb)
-    return ca.index(common) + cb.index(common)
+    between = ca[1:ca.index(common) + 1] + cb[1:cb.index(common)]
+
+    def solid(x: str) -> bool:
+        return bool(by_name[x].geoms)
+
+    hops = sum(1 for x in between if solid(x)) + 1
+    return hops - (0 if solid(common) or common in (a, b) else 1)
 
 
 @dataclass
@@ -100,7 +109,7 @@ class CollisionModel:
         for i in range(self.n_robot):
             for j in range(i + 1, self.n_robot):
                 la, lb = self.robot_link_of[i], self.robot_link_of[j]
-                if la != lb and _tree_distance(tree, la, lb) >= 3:
+                if la != lb and _tree_distance(tree, la, lb) >= 2:
                     candidates.append((i, j))
         for i, j in candidates:
             geom.addCollisionPair(pin.CollisionPair(i, j))

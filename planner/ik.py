@@ -2,8 +2,8 @@
 
 Supporting holds are hard tasks (a foot: full pose; a hand: position plus grip axis along
 the rail); moving targets are soft with a high weight, so an unreachable target yields
-a best effort whose residual is reported instead of an infeasible QP. The CoM is kept
-inside a (clockwise) support polygon by a hard constraint; a soft posture task pulls
+a best effort whose residual is reported instead of an infeasible QP. The CoM is pulled
+inside a (clockwise) support polygon by a heavily weighted constraint; a soft posture task pulls
 towards the primitive's seed posture.
 """
 
@@ -29,14 +29,21 @@ class IKConfig:
 
     max_iterations: int = 80
     step_dt_s: float = 0.02
-    position_tol_m: float = 1e-4
-    angle_tol_rad: float = 2e-3
-    moving_position_weight: float = 100.0
-    moving_orientation_weight: float = 10.0
+    position_tol_m: float = 1e-4  # supporting holds (hard tasks)
+    moving_tol_m: float = 1e-3  # a moving limb reaching its new hold
+    waypoint_tol_m: float = 5e-3  # a moving limb in the air, between way-points
+    angle_tol_rad: float = 2e-3  # supporting holds
+    moving_angle_tol_rad: float = 3e-3  # a moving limb reaching its new hold
+    waypoint_angle_tol_rad: float = 0.01  # a moving limb in the air: 0.6°
+    # Moving targets are soft (an unreachable one must not make the QP infeasible) but
+    # weighted 10⁶ above the posture so their residual is negligible.
+    moving_position_weight: float = 1e4
+    moving_orientation_weight: float = 1e3
     posture_weight: float = 1e-2
     torso_upright_weight: float = 0.5
     regularization: float = 1e-4
     com_margin_m: float = 0.01
+    com_polygon_weight: float = 1e3
 
 
 @dataclass
@@ -111,17 +118,21 @@ def solve_ik(kin: HuboKinematics, q_seed: np.ndarray, support: tuple[Hold, ...],
         jt.set_joints({k: v for k, v in posture_rad.items() if k in names})
         jt.configure("posture", "soft", config.posture_weight)
     if torso_R is not None:
-        ot = solver.add_orientation_task("torso_frame", torso_R)
-        ot.configure("torso_upright", "soft", config.torso_upright_weight)
+        # Torso and pelvis both face the ladder: otherwise waist and hip yaws trade off
+        # freely and neighbouring IK solutions twist the pelvis by tens of degrees.
+        for frame in ("torso_frame", "pelvis"):
+            ot = solver.add_orientation_task(frame, torso_R)
+            ot.configure(f"{frame}_upright", "soft", config.torso_upright_weight)
     if pelvis_target_m is not None and pelvis_weight > 0:
         pt = solver.add_position_task("pelvis", np.asarray(pelvis_target_m, dtype=float))
         pt.configure("pelvis", "soft", pelvis_weight)
     if com_polygon_cw is not None:
         cc = solver.add_com_polygon_constraint(np.asarray(com_polygon_cw, dtype=float),
                                                config.com_margin_m)
-        cc.configure("com_polygon", "hard")
+        # Soft: a hard polygon is infeasible for a start outside it within one bounded
+        # step. Stability is verified on the result anyway.
+        cc.configure("com_polygon", "soft", config.com_polygon_weight)
     solver.add_regularization_task(config.regularization)
-    holds = support + moving
     it = 0
     pos_err = ang_err = np.inf
     for it in range(1, config.max_iterations + 1):
@@ -132,13 +143,24 @@ def solve_ik(kin: HuboKinematics, q_seed: np.ndarray, support: tuple[Hold, ...],
             log.debug("IK QP failed at iteration %d: %s", it, exc)
             break
         robot.update_kinematics()
-        errs = [_hold_error(kin, h.frame, h.T_world_frame, h.is_hand) for h in holds]
-        pos_err = max((e[0] for e in errs), default=0.0)
-        ang_err = max((e[1] for e in errs), default=0.0)
-        if pos_err < config.position_tol_m and ang_err < config.angle_tol_rad and it > 2:
+        pos_err, ang_err, ok = _errors(kin, support, moving, config)
+        if ok and it > 2:
             break
-    converged = bool(pos_err < config.position_tol_m and ang_err < config.angle_tol_rad)
+    converged = bool(np.isfinite(pos_err)) and _errors(kin, support, moving, config)[2]
     return IKResult(kin.q, converged, it, float(pos_err), float(ang_err))
+
+
+def _errors(kin: HuboKinematics, support, moving, config: IKConfig) -> tuple[float, float, bool]:
+    """Worst position and angle errors, and whether every hold meets its tolerance."""
+    ok = True
+    pos_err = ang_err = 0.0
+    for holds, tol, atol in ((support, config.position_tol_m, config.angle_tol_rad),
+                             (moving, config.moving_tol_m, config.moving_angle_tol_rad)):
+        for h in holds:
+            dp, da = _hold_error(kin, h.frame, h.T_world_frame, h.is_hand)
+            ok &= dp < tol and da < atol
+            pos_err, ang_err = max(pos_err, dp), max(ang_err, da)
+    return pos_err, ang_err, ok
 
 
 def _add_hold_task(solver, hold: Hold, priority: str, w_pos: float, w_ori: float) -> None:

@@ -11,6 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import pinocchio as pin
 
 from planner.contacts import Hold, Stance
 from planner.ik import IKConfig, solve_ik
@@ -40,27 +41,24 @@ class InterpolationStats:
 
 def _interp_pose(Ta: np.ndarray, Tb: np.ndarray, s: float) -> np.ndarray:
     """Position linear, rotation along the geodesic."""
-    from scipy.spatial.transform import Rotation, Slerp
-
     T = np.eye(4)
     T[:3, 3] = (1 - s) * Ta[:3, 3] + s * Tb[:3, 3]
-    slerp = Slerp([0, 1], Rotation.from_matrix([Ta[:3, :3], Tb[:3, :3]]))
-    T[:3, :3] = slerp([s]).as_matrix()[0]
+    T[:3, :3] = Ta[:3, :3] @ pin.exp3(s * pin.log3(Ta[:3, :3].T @ Tb[:3, :3]))
     return T
 
 
 def contact_space_interpolate(kin: HuboKinematics, checker: FeasibilityChecker,
                               qa: np.ndarray, qb: np.ndarray, support: tuple[Hold, ...],
                               stability_stance: Stance, contacts: dict[str, str], *,
-                              moving: Hold | None = None, resolution_rad: float = 0.01,
+                              moving: tuple[Hold, ...] = (), resolution_rad: float = 0.01,
                               max_depth: int = 14, ik_config: IKConfig = IKConfig(),
                               stats: InterpolationStats | None = None) -> list[np.ndarray]:
     """Configurations from ``qa`` (excluded) to ``qb`` (included), each within
     ``resolution_rad`` of the next in every joint, all on the contact constraints.
 
     Args:
-        moving: if given, a hold template whose frame moves; its target at each midpoint
-            is the pose halfway between its poses at the two neighbours.
+        moving: hold templates of the moving limbs; at each midpoint a moving frame's
+            target is the pose halfway between its poses at the two neighbours.
 
     Raises:
         InterpolationError: a midpoint did not project or is infeasible.
@@ -76,22 +74,21 @@ def contact_space_interpolate(kin: HuboKinematics, checker: FeasibilityChecker,
             raise InterpolationError("resolution not reached", depth)
         stats.max_depth = max(stats.max_depth, depth + 1)
         qm = kin.interpolate(q0, q1, 0.5)
-        moving_targets: tuple[Hold, ...] = ()
-        if moving is not None:
-            Tm = _interp_pose(kin.frame_pose(q0, moving.frame), kin.frame_pose(q1, moving.frame),
-                              0.5)
-            moving_targets = (Hold(moving.limb, moving.target, Tm, moving.points_m,
-                                   moving.normals, moving.friction),)
+        moving_targets = tuple(
+            Hold(h.limb, h.target, _interp_pose(kin.frame_pose(q0, h.frame),
+                                                kin.frame_pose(q1, h.frame), 0.5),
+                 h.points_m, h.normals, h.friction)
+            for h in moving)
         posture = {name: float(qm[kin.model.joints[kin.model.getJointId(name)].idx_q])
                    for name in kin.wrapper.joint_names()}
         cfg = IKConfig(**{**ik_config.__dict__, "posture_weight": MIDPOINT_POSTURE_WEIGHT,
-                          "torso_upright_weight": 0.0})
+                          "torso_upright_weight": 0.0,
+                          "moving_tol_m": ik_config.waypoint_tol_m})
         res = solve_ik(kin, qm, support, moving_targets, posture_rad=posture,
                        com_polygon_cw=polygon, config=cfg)
         stats.projections += 1
         if not res.converged:
             raise InterpolationError(f"projection failed: {res!r}", depth)
-        # The hand's fingers are not moved by IK: carry them over from the midpoint.
         verdict = checker.check(res.q, stability_stance, contacts)
         if not verdict.ok:
             raise InterpolationError(f"midpoint infeasible: {verdict.reason}", depth)

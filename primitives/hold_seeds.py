@@ -64,5 +64,10 @@ def foot_on_rung(limb: str, rung: int) -> RungSeed:
     return RungSeed(limb, rung, lateral)
 
 
-def hand_on_rail(limb: str, rung: int) -> RailSeed:
-    return RailSeed(limb, "left" if limb == "left_hand" else "right", rung)
+#: Where the hands first take the rails from the floor, along the rail from the point
+#: above rung 0 [m]: lower and nearer, within reach of a robot standing on the floor.
+MOUNT_ALONG_RAIL_M = -0.2
+
+
+def hand_on_rail(limb: str, rung: int, along_m: float = 0.0) -> RailSeed:
+    return RailSeed(limb, "left" if limb == "left_hand" else "right", rung, along_m)

@@ -8,23 +8,29 @@ both hands move to the rail above rung k+1.
 
 from __future__ import annotations
 
-from primitives.hold_seeds import foot_on_rung, hand_on_rail
-from primitives.primitive import Primitive, Step
+from primitives.hold_seeds import MOUNT_ALONG_RAIL_M, foot_on_rung, hand_on_rail
+from primitives.primitive import LimbWaypoints, Primitive, Step
 
-# Seed postures [rad]: arms reaching forward and out to the rails with bent elbows, legs
-# bent (a straight knee is a kinematic singularity), fingers set by the planner.
+# Seed postures [rad]: arms reaching forward and out to the rails with bent elbows; legs
+# a little bent (a straight knee is a kinematic singularity). Fingers are set by the
+# planner. Foot moves leave the legs to the pelvis target (over the stance foot).
 _ARMS = {"LSP": -0.6, "RSP": -0.6, "LSR": 0.5, "RSR": -0.5, "LEB": -1.0, "REB": -1.0}
-_CROUCH = {"LHP": -0.7, "RHP": -0.7, "LKN": 1.3, "RKN": 1.3, "LAP": -0.6, "RAP": -0.6}
 _STAND = {"LHP": -0.35, "RHP": -0.35, "LKN": 0.6, "RKN": 0.6, "LAP": -0.25, "RAP": -0.25}
 
+#: Hands stand off 10 cm from the rail before closing in: palm plate (2 cm) and open
+#: fingers (2.2 cm) must pass a 2.5 cm-radius rail with margin.
+_HAND_PATH = LimbWaypoints(lift_m=0.0, clearance_m=0.10)
+
 PLACE_HANDS = Primitive("placeHands", ("left_hand", "right_hand"), {**_ARMS, **_STAND},
-                        pelvis_offset_m=(-0.15, 0.0, 0.90))
-PLACE_L_FOOT = Primitive("placeLFoot", ("left_foot",), {**_ARMS, **_CROUCH})
-PLACE_R_FOOT = Primitive("placeRFoot", ("right_foot",), {**_ARMS, **_CROUCH})
-MOVE_L_HAND = Primitive("moveLHand", ("left_hand",), {**_ARMS, **_STAND})
-MOVE_R_HAND = Primitive("moveRHand", ("right_hand",), {**_ARMS, **_STAND})
-MOVE_L_FOOT = Primitive("moveLFoot", ("left_foot",), {**_ARMS, **_CROUCH})
-MOVE_R_FOOT = Primitive("moveRFoot", ("right_foot",), {**_ARMS, **_CROUCH})
+                        pelvis_offset_m=(-0.05, 0.0, 0.90), waypoints=_HAND_PATH)
+PLACE_L_FOOT = Primitive("placeLFoot", ("left_foot",), _ARMS)
+PLACE_R_FOOT = Primitive("placeRFoot", ("right_foot",), _ARMS)
+MOVE_L_HAND = Primitive("moveLHand", ("left_hand",), {**_ARMS, **_STAND},
+                        waypoints=_HAND_PATH)
+MOVE_R_HAND = Primitive("moveRHand", ("right_hand",), {**_ARMS, **_STAND},
+                        waypoints=_HAND_PATH)
+MOVE_L_FOOT = Primitive("moveLFoot", ("left_foot",), _ARMS)
+MOVE_R_FOOT = Primitive("moveRFoot", ("right_foot",), _ARMS)
 #: Straighten the legs with every hold kept: the body rises over the new rung.
 STRAIGHTEN = Primitive("straighten", (), {**_ARMS, **_STAND}, pelvis_offset_m=(-0.2, 0.0, 0.85))
 
@@ -37,7 +43,8 @@ def climb_sequence(top_rung: int) -> list[Step]:
     if top_rung < 0:
         raise ValueError(f"top rung must be ≥ 0, got {top_rung}")
     steps = [
-        Step(PLACE_HANDS, (hand_on_rail("left_hand", 0), hand_on_rail("right_hand", 0)), 0),
+        Step(PLACE_HANDS, (hand_on_rail("left_hand", 0, MOUNT_ALONG_RAIL_M),
+                           hand_on_rail("right_hand", 0, MOUNT_ALONG_RAIL_M)), 0),
         Step(PLACE_L_FOOT, (foot_on_rung("left_foot", 0),), 0),
         Step(PLACE_R_FOOT, (foot_on_rung("right_foot", 0),), 0),
         Step(STRAIGHTEN, (), 0),

@@ -35,15 +35,17 @@ class Primitive:
         moving_limbs: limbs that leave their holds and take the new ones (empty for a
             body move with every hold kept).
         posture_rad: seed posture, joint name → angle [rad], a soft preference for IK.
-        pelvis_offset_m: seed pelvis position relative to the mean of the foot holds,
-            in the ladder frame (x up-ladder, y left, z up) [m].
+        pelvis_offset_m: seed pelvis position relative to the mean of the supporting
+            foot holds, in the ladder frame (x up-ladder, y left, z up) [m]. Standing on
+            one foot, this puts the pelvis over it with the stance leg nearly straight:
+            a bent knee under the body's weight exceeds its 60 N·m.
         waypoints: the moving limb's way-point recipe.
     """
 
     name: str
     moving_limbs: tuple[str, ...]
     posture_rad: dict[str, float] = field(default_factory=dict)
-    pelvis_offset_m: tuple[float, float, float] = (-0.25, 0.0, 0.75)
+    pelvis_offset_m: tuple[float, float, float] = (-0.1, 0.0, 0.88)
     waypoints: LimbWaypoints = LimbWaypoints()
 
 

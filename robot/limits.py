@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import cache
 
 import numpy as np
 
@@ -25,7 +25,7 @@ class JointLimits:
     torque_max_nm: np.ndarray
 
 
-@lru_cache(maxsize=None)
+@cache
 def joint_limits(robot: str | RobotParams = "drc-hubo") -> JointLimits:
     """Limits of every column for a robot (by name or parameter table)."""
     p = robot_params(robot) if isinstance(robot, str) else robot

@@ -1,0 +1,410 @@
+"""Algorithm 5 of the thesis: randomized sequential descent over the primitive sequence.
+
+Each step samples a hold near the primitive's seed hold (radius 0 at first, growing with
+failures), a configuration feasible at both the old and the new stance, and a path. A
+step that fails ``samples_per_step`` times backtracks: the previous step is re-sampled.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+import pinocchio as pin
+
+from ladders.geometry import LadderGeometry
+from ladders.spec import LadderSpec
+from planner.collision import CollisionModel
+from planner.contacts import Hold, Stance
+from planner.feasible import FeasibleSearchStats, SearchTarget, find_feasible
+from planner.holds import make_hold
+from planner.ik import IKConfig, solve_ik
+from planner.interpolation import (
+    InterpolationError,
+    InterpolationStats,
+    contact_space_interpolate,
+)
+from planner.kinematics import HuboKinematics
+from planner.limb_path import foot_waypoints, hand_waypoints
+from planner.validity import FeasibilityChecker
+from primitives.hold_seeds import FloorSeed, RailSeed
+from primitives.library import climb_sequence
+from primitives.primitive import Step
+from robot.errors import HuboLadderError
+from robot.joints import ARM_JOINTS, FINGER_JOINTS
+from robot.kinematic_tree import FINGER_CLOSED_RAD
+
+log = logging.getLogger(__name__)
+
+#: Largest joint correction [rad] when a placed limb is snapped exactly onto its hold.
+POLISH_MAX_RAD = 0.05
+#: Weight of the seed pelvis position in IK (soft, against hard holds).
+PELVIS_WEIGHT = 1.0
+#: Start posture [rad], per side (roll signs mirrored): knees a little bent (a straight
+#: knee is an IK singularity), arms in a ready pose forward and out, elbows bent.
+START_POSTURE = {"HP": -0.2, "KN": 0.4, "AP": -0.2, "SP": -0.5, "SR": 0.3, "EB": -1.2}
+
+
+@dataclass(frozen=True)
+class PlannerConfig:
+    """Tunables of the search (defaults from the thesis where it gives them)."""
+
+    samples_per_step: int = 50
+    resolution_rad: float = 0.01
+    hold_radius_step_m: float = 0.01  # perturbation radius growth per failed sample
+    hold_radius_max_m: float = 0.05
+    feasible_attempts: int = 3
+    max_backtracks: int = 30
+    time_limit_s: float = 600.0
+    min_margin_m: float = 0.0
+
+
+class PlanningFailed(HuboLadderError):
+    """No plan was found; names the primitive and rung that failed."""
+
+    def __init__(self, step: Step, reason: str):
+        super().__init__(f"no feasible {step.primitive.name} at rung {step.rung}: {reason}")
+        self.step = step
+        self.reason = reason
+
+
+@dataclass
+class PathSegment:
+    """Dense configurations of one phase of one step."""
+
+    step: Step
+    phase: str  # body | release | limb | grasp
+    holds: tuple[Hold, ...]  # holds in contact during the phase
+    moving_limbs: tuple[str, ...]
+    configs: list[np.ndarray] = field(repr=False)
+
+
+@dataclass
+class StepStats:
+    label: str
+    seconds: float = 0.0
+    samples: int = 0
+    backtracks: int = 0
+    min_margin_m: float = np.inf
+    max_torque_ratio: float = 0.0
+    failures: dict[str, int] = field(default_factory=dict)
+
+
+@dataclass
+class SearchResult:
+    segments: list[PathSegment]
+    final_stance: Stance
+    step_stats: list[StepStats]
+    total_s: float
+
+
+def _limb_side(limb: str) -> str:
+    return "left" if limb.startswith("left") else "right"
+
+
+class ClimbPlanner:
+    """Plans a climb of one ladder for one robot."""
+
+    def __init__(self, spec: LadderSpec, robot: str = "drc-hubo",
+                 config: PlannerConfig = PlannerConfig(), seed: int = 1):
+        from ladders.collision import ladder_collision_objects
+
+        self.spec = spec
+        self.geom = LadderGeometry(spec)
+        self.kin = HuboKinematics.load(robot)
+        self.collision = CollisionModel(self.kin, ladder_collision_objects(spec))
+        self.checker = FeasibilityChecker(self.kin, self.collision, config.min_margin_m)
+        self.config = config
+        self.seed = seed
+        self.rng = np.random.default_rng(seed)
+        self.torso_R = self.geom.R_world_ladder.copy()
+        self.away = -self.geom.R_world_ladder[:, 0]
+        self.ik_config = IKConfig()
+        self.ik_waypoint_config = IKConfig(
+            moving_tol_m=self.ik_config.waypoint_tol_m,
+            moving_angle_tol_rad=self.ik_config.waypoint_angle_tol_rad)
+
+    # ----------------------------------------------------------------------------------
+    def start_configuration(self) -> tuple[np.ndarray, Stance]:
+        """Standing on the floor at the world origin, limbs slightly bent, hands open."""
+        kin = self.kin
+        q = pin.neutral(kin.model)
+        q[2] = kin.params.pelvis_height_m
+        for side, sign in (("L", 1.0), ("R", -1.0)):
+            for joint, v in START_POSTURE.items():
+                if kin.model.existJointName(side + joint):
+                    mirrored = sign * v if joint == "SR" else v
+                    q[kin.model.joints[kin.model.getJointId(side + joint)].idx_q] = mirrored
+        floor = {}
+        for limb, frame in (("left_foot", "L_sole"), ("right_foot", "R_sole")):
+            T = np.eye(4)
+            T[:3, 3] = kin.frame_pose(q, frame)[:3, 3] * [1, 1, 0]
+            floor[limb] = T
+        holds = tuple(make_hold(FloorSeed(limb), self.geom, kin.params, floor) for limb in floor)
+        stance = Stance(holds)
+        res = self._project(q, holds)
+        return res, stance
+
+    def _project(self, q: np.ndarray, holds: tuple[Hold, ...]) -> np.ndarray:
+        r = solve_ik(self.kin, q, holds, torso_R=self.torso_R)
+        if not r.converged:
+            raise HuboLadderError(f"cannot stand at the start pose: {r!r}")
+        return r.q
+
+    def top_rung(self) -> int:
+        """Highest rung whose next rail point (where the hands hold while the feet step up)
+        still lies on the rails, a hand's width from their end."""
+        p0, p1 = self.geom.rail_axis("left")
+        rail_len = float(np.linalg.norm(p1 - p0))
+        best = 0
+        for k in range(self.spec.num_rungs):
+            s = self.spec.rung_height_m(k) / np.sin(self.spec.slope_rad)
+            if s + 0.05 <= rail_len:
+                best = k
+        return best
+
+    # ----------------------------------------------------------------------------------
+    def _contacts(self, holds) -> dict[str, str]:
+        return {h.limb: h.target for h in holds}
+
+    def _with_fingers(self, q: np.ndarray, side: str, value: float) -> np.ndarray:
+        out = q.copy()
+        for name in FINGER_JOINTS[side]:
+            if self.kin.model.existJointName(name):
+                out[self.kin.model.joints[self.kin.model.getJointId(name)].idx_q] = value
+        return out
+
+    def _finger_path(self, q: np.ndarray, side: str, value: float) -> list[np.ndarray]:
+        """Open or close a hand in steps no larger than the resolution."""
+        idx = [self.kin.model.joints[self.kin.model.getJointId(n)].idx_q
+               for n in FINGER_JOINTS[side] if self.kin.model.existJointName(n)]
+        start = q[idx].copy()
+        n = max(1, int(np.ceil(np.max(np.abs(value - start)) / self.config.resolution_rad)))
+        out = []
+        for i in range(1, n + 1):
+            qi = q.copy()
+            qi[idx] = start + (value - start) * i / n
+            out.append(qi)
+        return out
+
+    def _sample_hold(self, seed, radius_m: float) -> Hold:
+        if radius_m > 0:
+            along = self.rng.uniform(-radius_m, radius_m)
+            lateral = 0.0 if isinstance(seed, RailSeed) else self.rng.uniform(-radius_m,
+                                                                              radius_m) / 2
+        else:
+            along = lateral = 0.0
+        return make_hold(seed, self.geom, self.kin.params, offset_m=(along, lateral))
+
+    def _pelvis_target(self, step: Step, support) -> np.ndarray:
+        """Seed pelvis position: the primitive's offset from the supporting feet."""
+        feet = [h.T_world_frame[:3, 3] for h in support if not h.is_hand]
+        offset = self.geom.R_world_ladder @ np.array(step.primitive.pelvis_offset_m)
+        return np.mean(feet, axis=0) + offset
+
+    def _posture(self, step: Step, q: np.ndarray, support) -> dict[str, float]:
+        """Seed posture: the primitive's, except that an arm holding a rail prefers where
+        it is. A 7-joint arm on a fixed hand can fold two ways; jumping between them has
+        no continuous path on the hold."""
+        posture = dict(step.primitive.posture_rad)
+        for h in support:
+            if h.is_hand:
+                for name in ARM_JOINTS[_limb_side(h.limb)]:
+                    if self.kin.model.existJointName(name):
+                        jid = self.kin.model.getJointId(name)
+                        posture[name] = float(q[self.kin.model.joints[jid].idx_q])
+        return posture
+
+    def _target(self, step: Step, support, moving, stability: Stance, contacts,
+                pelvis=None, weight=PELVIS_WEIGHT, q=None) -> SearchTarget:
+        posture = step.primitive.posture_rad if q is None else self._posture(step, q, support)
+        return SearchTarget(support=tuple(support), moving=tuple(moving),
+                            stability_stance=stability, contacts=contacts,
+                            posture_rad=posture, pelvis_target_m=pelvis,
+                            pelvis_weight=weight, torso_R=self.torso_R,
+                            retreat_direction=self.away)
+
+    def _interp(self, qa, qb, support, stability, contacts, stats: StepStats, moving=()):
+        istats = InterpolationStats()
+        path = contact_space_interpolate(self.kin, self.checker, qa, qb, tuple(support),
+                                         stability, contacts, moving=moving,
+                                         resolution_rad=self.config.resolution_rad,
+                                         stats=istats)
+        stats.min_margin_m = min(stats.min_margin_m, istats.min_margin_m)
+        stats.max_torque_ratio = max(stats.max_torque_ratio, istats.max_torque_ratio)
+        return path
+
+    # ----------------------------------------------------------------------------------
+    def try_step(self, step: Step, q: np.ndarray, stance: Stance, radius_m: float,
+                 stats: StepStats) -> tuple[list[PathSegment], np.ndarray, Stance]:
+        """One sample of a step; raises `InterpolationError`/`_StepRejected` on failure."""
+        prim = step.primitive
+        moving_limbs = prim.moving_limbs
+        support = tuple(h for h in stance.holds if h.limb not in moving_limbs)
+        support_stance = Stance(support)
+        new_holds = tuple(self._sample_hold(seed, radius_m) for seed in step.new_holds)
+        next_stance = Stance(support + new_holds)
+        fstats = FeasibleSearchStats()
+        segments: list[PathSegment] = []
+
+        if not moving_limbs:  # straighten: every hold kept, the body rises
+            pelvis = self._pelvis_target(step, stance.holds)
+            target = self._target(step, stance.holds, (), stance, self._contacts(stance.holds),
+                                  pelvis, q=q)
+            q_new, verdict = find_feasible(self.kin, self.checker, q, target, self.rng,
+                                           attempts=self.config.feasible_attempts, stats=fstats)
+            if q_new is None:
+                raise _StepRejected(f"no straightened pose: {verdict.reason if verdict is not None else '?'}")
+            path = self._interp(q, q_new, stance.holds, stance, self._contacts(stance.holds),
+                                stats)
+            segments.append(PathSegment(step, "body", stance.holds, (), path))
+            return segments, q_new, stance
+
+        # 1. Lift-off configuration: every current hold kept, stable without the moving limbs.
+        contacts_all = self._contacts(stance.holds)
+        pelvis = self._pelvis_target(step, support)
+        lift_target = self._target(step, stance.holds, (), support_stance, contacts_all, pelvis,
+                                   q=q)
+        verdict = self.checker.check(q, support_stance, contacts_all)
+        if verdict.ok:
+            q_lift = q
+        else:
+            q_lift, verdict = find_feasible(self.kin, self.checker, q, lift_target, self.rng,
+                                            attempts=self.config.feasible_attempts,
+                                            stats=fstats)
+            if q_lift is None:
+                raise _StepRejected(f"no lift-off pose: {verdict.reason if verdict is not None else '?'}")
+            path = self._interp(q, q_lift, stance.holds, stance, contacts_all, stats)
+            segments.append(PathSegment(step, "body", stance.holds, (), path))
+
+        # 2. Open the hands that let go.
+        q_cur = q_lift
+        for limb in moving_limbs:
+            old = stance.hold(limb)
+            if limb.endswith("hand") and old is not None:
+                path = self._finger_path(q_cur, _limb_side(limb), 0.0)
+                segments.append(PathSegment(step, "release", support, moving_limbs, path))
+                q_cur = path[-1]
+
+        # 3. Way-points of the moving limbs (moved together), then interpolation.
+        way = {}
+        for hold in new_holds:
+            T_from = self.kin.frame_pose(q_cur, hold.frame)
+            old = stance.hold(hold.limb)
+            if hold.is_hand:
+                way[hold.limb] = hand_waypoints(T_from, hold, self.geom, prim.waypoints,
+                                                on_rail=old is not None)
+            else:
+                way[hold.limb] = foot_waypoints(T_from, hold, self.geom, self.kin.params,
+                                                prim.waypoints, step.rung)
+        n_way = max(len(w) for w in way.values())
+        for w in way.values():  # equal counts: repeat the final pose
+            w.extend([w[-1]] * (n_way - len(w)))
+        contacts_support = self._contacts(support)
+        limb_path: list[np.ndarray] = []
+        for i in range(1, n_way):
+            targets = tuple(Hold(h.limb, h.target, way[h.limb][i], h.points_m, h.normals,
+                                 h.friction) for h in new_holds)
+            contacts = dict(contacts_support)
+            if i == 1:  # leaving: may still touch the old hold's object
+                contacts.update({lb: stance.hold(lb).target for lb in moving_limbs
+                                 if stance.hold(lb) is not None})
+            if i == n_way - 1:  # arriving
+                contacts.update({h.limb: h.target for h in new_holds})
+            target = self._target(step, support, targets, support_stance, contacts, pelvis,
+                                  q=q_cur)
+            final = i == n_way - 1
+            q_next, verdict = find_feasible(
+                self.kin, self.checker, q_cur, target, self.rng,
+                attempts=self.config.feasible_attempts, stats=fstats,
+                ik_config=self.ik_config if final else self.ik_waypoint_config)
+            if q_next is None:
+                raise _StepRejected(f"way-point {i}/{n_way - 1}: "
+                                    f"{verdict.reason if verdict is not None else '?'}")
+            limb_path += self._interp(q_cur, q_next, support, support_stance, contacts,
+                                      stats, moving=targets)
+            q_cur = q_next
+        segments.append(PathSegment(step, "limb", support, moving_limbs, limb_path))
+
+        # 4. Polish: the new holds become hard tasks, met to solver precision, and the
+        # placed configuration must be feasible in the new stance too.
+        polished = solve_ik(self.kin, q_cur, next_stance.holds, config=self.ik_config)
+        if not polished.converged:
+            raise _StepRejected(f"placed pose does not meet its holds: {polished!r}")
+        correction = self.kin.joint_distance(polished.q, q_cur)
+        if correction > POLISH_MAX_RAD:
+            raise _StepRejected(f"placing the holds exactly moves a joint {correction:.3f} rad")
+        n = int(np.ceil(correction / self.config.resolution_rad))
+        limb_path += [self.kin.interpolate(q_cur, polished.q, (k + 1) / n) for k in range(n)]
+        q_cur = polished.q
+        verdict = self.checker.check(q_cur, next_stance, self._contacts(next_stance.holds))
+        if not verdict.ok:
+            raise _StepRejected(f"placed pose unstable in the new stance: {verdict.reason}")
+
+        # 5. Close the hands that arrived on a rail.
+        for hold in new_holds:
+            if hold.is_hand:
+                path = self._finger_path(q_cur, _limb_side(hold.limb), FINGER_CLOSED_RAD)
+                segments.append(PathSegment(step, "grasp", next_stance.holds, (), path))
+                q_cur = path[-1]
+        stats.samples += fstats.attempts
+        for k, v in (fstats.rejections or {}).items():
+            stats.failures[k] = stats.failures.get(k, 0) + v
+        return segments, q_cur, next_stance
+
+    # ----------------------------------------------------------------------------------
+    def plan(self, top_rung: int | None = None,
+             progress: Callable[[int, int, Step, StepStats], None] | None = None
+             ) -> SearchResult:
+        """Search the whole climb; raises `PlanningFailed` when the time or samples run out."""
+        t_start = time.perf_counter()
+        top = self.top_rung() if top_rung is None else top_rung
+        if not 0 <= top < self.spec.num_rungs:
+            raise HuboLadderError(f"top rung {top} is not on the ladder (0..{self.spec.num_rungs - 1})")
+        steps = climb_sequence(top)
+        q0, stance0 = self.start_configuration()
+        # Stack of (segments, q, stance) after each completed step.
+        states: list[tuple[list[PathSegment], np.ndarray, Stance]] = [([], q0, stance0)]
+        failures = [0] * len(steps)
+        stats = [StepStats(s.label) for s in steps]
+        backtracks = 0
+        i = 0
+        while i < len(steps):
+            step = steps[i]
+            _, q, stance = states[-1]
+            t0 = time.perf_counter()
+            radius = min(self.config.hold_radius_max_m,
+                         failures[i] * self.config.hold_radius_step_m)
+            if time.perf_counter() - t_start > self.config.time_limit_s:
+                raise PlanningFailed(step, f"time limit of {self.config.time_limit_s:g} s reached")
+            try:
+                segs, q_new, stance_new = self.try_step(step, q, stance, radius, stats[i])
+            except (_StepRejected, InterpolationError) as exc:
+                failures[i] += 1
+                stats[i].seconds += time.perf_counter() - t0
+                key = str(exc).split(":")[0][:40]
+                stats[i].failures[key] = stats[i].failures.get(key, 0) + 1
+                log.debug("%s sample %d failed: %s", step.label, failures[i], exc)
+                if failures[i] >= self.config.samples_per_step:
+                    if i == 0 or backtracks >= self.config.max_backtracks:
+                        raise PlanningFailed(step, f"{failures[i]} samples failed; last: {exc}") from None
+                    backtracks += 1
+                    stats[i - 1].backtracks += 1
+                    failures[i] = 0
+                    states.pop()
+                    i -= 1
+                continue
+            stats[i].seconds += time.perf_counter() - t0
+            states.append((segs, q_new, stance_new))
+            if progress is not None:
+                progress(i, len(steps), step, stats[i])
+            i += 1
+        segments = [seg for segs, _, _ in states for seg in segs]
+        return SearchResult(segments, states[-1][2], stats, time.perf_counter() - t_start)
+
+
+class _StepRejected(Exception):
+    """One sample of a step failed (the search tries another)."""
