@@ -15,27 +15,41 @@ Two implementations behind the one interface:
 - `ShmChannel`: between processes. One file in ``/dev/shm`` per channel and daemon
   instance (``hubo-ladder.<instance>.<name>``), mapped with `mmap`:
 
-  - one slot per writer, each guarded by a seqlock (odd counter = write in progress);
-    a reader copies the newest complete slot and re-checks its counter;
+  - one slot per writer with two data buffers: the writer fills the buffer readers are
+    not pointed at, then publishes it under a seqlock (odd counter while the slot's row
+    of stamp and buffer index changes, a few hundred ns). A reader copies the newest
+    published buffer and re-checks the counter. A writer preempted or killed mid-copy
+    never hides its previous sample;
   - slots are claimed with Linux open-file-description locks (``F_OFD_SETLK``), which the
     kernel drops when a process dies, so a killed writer's slot is free for the next one;
-  - a blocked reader sleeps in ``recv`` on an abstract-namespace UNIX datagram socket
+  - a blocked reader sleeps in ``poll`` on an abstract-namespace UNIX datagram socket
     (``@hubo-ladder/<instance>/<name>/r<k>``); it raises a "waiting" byte first, and a
-    writer sends one empty datagram to each waiting reader after a write. Abstract
-    sockets vanish with their process: nothing to clean up after a crash. A lost wake-up
-    (theoretically possible, the fence is a lock round trip) costs at most
-    ``WAKE_SLICE_S``: a reader re-checks the slots that often while it waits;
+    writer sends each waiting reader a one-byte datagram naming the slot it just
+    published, so the woken reader copies that slot without scanning. Abstract sockets
+    vanish with their process: nothing to clean up after a crash. A lost wake-up
+    (theoretically possible; the fence is a lock round trip) costs at most
+    ``WAKE_SLICE_S``: a waiting reader re-checks the slots that often;
   - `cleanup_stale` removes channel files no live process has open (the daemon calls it
     at start-up).
 
-Why not iceoryx2 (0.10.0, the maintained IPC library the issue suggested)? Measured on
-the project machine (2 cores, one busy), two processes, 430-byte payload,
-write→blocked-reader-wakes: iceoryx2 publish/subscribe + event service 18.7 µs median,
-39–46 µs p99 (over the 11 µs target); this module 9–10 µs median (see
-``bench/bench_channels.py`` for the current figures). iceoryx2's wake-up goes through its
-event service, which costs ~12 µs more than a raw datagram. Reading by polling was fast
-with both. The seqlock assumes x86-64's store ordering (TSO); on weakly ordered CPUs the
-counter re-check would need real barriers.
+Why not iceoryx2 (0.10.0, the maintained IPC library the issue suggested)? Measured with
+``bench/bench_channels.py`` on the project VM (2 cores, with other jobs using one or both),
+two processes, the 421-byte ``ref`` struct, write → blocked reader wakes, median / p99:
+
+| mechanism | quieter run | busier run |
+|---|---|---|
+| this module | 16.4 / 51 µs | 38–43 / ~720 µs |
+| iceoryx2 pub/sub + event service | 35.1 / 650 µs | 65–68 / 170–570 µs |
+| bare datagram, no data (OS floor) | 8.0 µs | 13–24 µs |
+
+iceoryx2's wake-up path (its event service, then draining every publisher) costs two to
+three times this module's overhead over the OS floor, and adds a Rust extension and files
+under ``/tmp/iceoryx2``. Neither meets the 11 µs median target on this machine; the
+floor alone takes most of it there. On a quiet core expect roughly floor + 8 µs.
+
+The seqlock assumes x86-64's store ordering (TSO); on weakly ordered CPUs (aarch64) the
+counter re-check needs real barriers. Do not fork a process that holds a channel open:
+the child shares its open file description, and so its locks.
 """
 
 from __future__ import annotations
@@ -216,8 +230,9 @@ _MAGIC = b"HUBOCHN1"
 _VERSION = 1
 _HDR = struct.Struct("<8sIIIIQ")  # magic, version, sample_size, writers, readers, dtype crc
 _WAIT_OFF = 64  # MAX_READERS "waiting" bytes
-_TABLE_OFF = 128  # per writer slot: counter, time_ns, seq, writer_id (4 × u64)
-_TABLE = struct.Struct(f"<{4 * MAX_WRITERS}q")
+_TABLE_OFF = 128  # per writer slot, 8 × i64: counter, time_ns, seq, writer_id, buffer, pad
+_ROW_Q = 8
+_TABLE = struct.Struct(f"<{_ROW_Q * MAX_WRITERS}q")
 _DATA_OFF = _TABLE_OFF + _TABLE.size
 # Lock byte offsets (OFD locks may lie beyond the end of the file).
 _LOCK_INIT = 1 << 20
@@ -226,9 +241,11 @@ _LOCK_WRITER = _LOCK_INIT + 16
 _LOCK_READER = _LOCK_INIT + 64
 _STAMP = struct.Struct("<IQq")  # the struct header: writer_id, seq, time_ns
 _NOBODY_WAITING = bytes(MAX_READERS)
-_SLOT_NOTES = [bytes([i]) for i in range(MAX_WRITERS)]
+_COUNTER = struct.Struct("<q")
+_ROW_BODY = struct.Struct("<qqqq")  # time_ns, seq, writer_id, buffer (after the counter)
+_ROW_HEAD = struct.Struct("<qq")  # counter, time_ns
 _FLOCK = struct.Struct("hhqqi4x")  # struct flock on Linux x86-64 / aarch64
-_ODD_SPIN = 2000  # reads of a slot's counter before it is taken as stuck (dead writer)
+_ODD_SPIN = 2000  # reads of an odd counter before the slot is taken as stuck (dead writer)
 
 
 def _ofd_lock(fd: int, kind: int, start: int, wait: bool = False) -> bool:
@@ -314,7 +331,7 @@ class ShmChannel(Channel):
 
     def _open_segment(self) -> None:
         fd = self._fd
-        total = _DATA_OFF + MAX_WRITERS * self._stride
+        total = _DATA_OFF + MAX_WRITERS * 2 * self._stride
         crc = zlib.crc32(str(self.dtype.descr).encode())
         header = _HDR.pack(_MAGIC, _VERSION, self._size, MAX_WRITERS, MAX_READERS, crc)
         _ofd_lock(fd, fcntl.F_WRLCK, _LOCK_INIT, wait=True)
@@ -344,13 +361,20 @@ class ShmChannel(Channel):
     def _claim_writer_slot(self) -> int:
         for i in range(MAX_WRITERS):
             if _ofd_lock(self._fd, fcntl.F_WRLCK, _LOCK_WRITER + i):
-                off = _TABLE_OFF + 32 * i
-                (counter,) = struct.unpack_from("<q", self._mm, off)
-                if counter & 1:  # a writer died mid-write: the slot's data is torn
+                off = _TABLE_OFF + 8 * _ROW_Q * i
+                (counter,) = _COUNTER.unpack_from(self._mm, off)
+                if counter & 1:  # a writer died while publishing: the row may be torn
                     log.warning("%s: writer slot %d was torn by a dead writer", self.path, i)
-                    struct.pack_into("<qqqq", self._mm, off, counter + 1, 0, 0, 0)
+                    _ROW_BODY.pack_into(self._mm, off + 8, 0, 0, 0, 0)
+                    _COUNTER.pack_into(self._mm, off, counter + 1)
                 self._wsock = socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM)
                 self._wsock.setblocking(False)
+                self._counter, *_, self._buffer = _ROW_HEAD.unpack_from(self._mm, off) + (
+                    _ROW_BODY.unpack_from(self._mm, off + 8)
+                )
+                self._table_off = off
+                self._data_off = _DATA_OFF + 2 * i * self._stride
+                self._note = bytes([i])
                 self._wslot = i
                 return i
         raise ChannelError(f"{self.path}: all {MAX_WRITERS} writer slots are in use")
@@ -382,70 +406,71 @@ class ShmChannel(Channel):
         if not (isinstance(sample, np.ndarray) and sample.dtype == self.dtype):
             sample = np.asarray(sample, dtype=self.dtype)
         self._seq += 1
-        i = self._wslot
-        mm = self._mm
-        off = _TABLE_OFF + 32 * i
-        data = _DATA_OFF + i * self._stride
-        (counter,) = struct.unpack_from("<q", mm, off)
-        struct.pack_into("<q", mm, off, counter + 1)  # odd: writing
+        mm, off = self._mm, self._table_off
+        buffer = self._buffer ^ 1  # write the buffer readers are not pointed at
+        data = self._data_off + buffer * self._stride
         self._mv[data : data + self._size] = sample.tobytes()
         _STAMP.pack_into(mm, data, self.writer_id, self._seq, t_ns)
-        struct.pack_into("<qqqq", mm, off, counter + 2, t_ns, self._seq, self.writer_id)
+        counter = self._counter  # we own the slot: no need to read it back
+        _COUNTER.pack_into(mm, off, counter + 1)  # odd: publishing
+        _ROW_BODY.pack_into(mm, off + 8, t_ns, self._seq, self.writer_id, buffer)
+        _COUNTER.pack_into(mm, off, counter + 2)
+        self._counter, self._buffer = counter + 2, buffer
         with self._fence:  # full barrier (locked instruction) before reading the flags
             pass
         waiting = mm[_WAIT_OFF : _WAIT_OFF + MAX_READERS]
         if waiting != _NOBODY_WAITING:
-            note = _SLOT_NOTES[i]  # tells the reader which slot is newest
-            for k in range(MAX_READERS):
-                if waiting[k]:
-                    try:
-                        self._wsock.sendto(note, self._addrs[k])
-                    except OSError:  # reader gone or its queue full: it will re-check
-                        pass
+            k = waiting.find(1)
+            while k >= 0:
+                try:  # the note tells the reader which slot is the newest
+                    self._wsock.sendto(self._note, self._addrs[k])
+                except OSError:  # reader gone or its queue full: it will re-check
+                    pass
+                k = waiting.find(1, k + 1)
         return t_ns
 
     def _newest(self) -> tuple[int, tuple[int, int, int], int] | None:
-        """(slot, key, counter) of the newest complete slot, spinning over writes."""
+        """(slot, key, counter, buffer) of the newest published slot."""
         mm = self._mm
         for _ in range(_ODD_SPIN):
             table = _TABLE.unpack_from(mm, _TABLE_OFF)
             best = None
             busy = False
             for i in range(MAX_WRITERS):
-                counter = table[4 * i]
+                r = _ROW_Q * i
+                counter = table[r]
                 if counter == 0:
                     continue
                 if counter & 1:
                     if self._stuck.get(i) != counter:
                         busy = True
                     continue
-                key = (table[4 * i + 1], table[4 * i + 2], table[4 * i + 3])
+                key = (table[r + 1], table[r + 2], table[r + 3])
                 if best is None or key > best[1]:
-                    best = (i, key, counter)
+                    best = (i, key, counter, table[r + 4] & 1)
             if not busy:
                 return best
-        for i in range(MAX_WRITERS):  # still odd after the spin: a writer died mid-write
-            counter = table[4 * i]
+        for i in range(MAX_WRITERS):  # still odd after the spin: a writer died publishing
+            counter = table[_ROW_Q * i]
             if counter & 1 and self._stuck.get(i) != counter:
                 log.warning("%s: writer slot %d stuck mid-write; ignoring it", self.path, i)
                 self._stuck[i] = counter
         return best
 
-    def _read_slot(self, i: int, counter: int) -> np.ndarray | None:
-        """Copy slot ``i``; None if it changed from ``counter`` meanwhile."""
-        data = _DATA_OFF + i * self._stride
+    def _read_slot(self, i: int, counter: int, buffer: int) -> np.ndarray | None:
+        """Copy the published buffer of slot ``i``; None if the slot moved on meanwhile."""
+        data = _DATA_OFF + (2 * i + buffer) * self._stride
         buf = bytearray(self._mv[data : data + self._size])
-        (again,) = struct.unpack_from("<q", self._mm, _TABLE_OFF + 32 * i)
-        if again != counter:
+        if _COUNTER.unpack_from(self._mm, _TABLE_OFF + 8 * _ROW_Q * i)[0] != counter:
             return None
-        return np.frombuffer(buf, dtype=self.dtype).reshape(())
+        return np.ndarray((), self.dtype, buffer=buf)
 
     def read_latest(self) -> np.ndarray | None:
         for _ in range(_ODD_SPIN):
             found = self._newest()
             if found is None:
                 return None
-            sample = self._read_slot(found[0], found[2])
+            sample = self._read_slot(found[0], found[2], found[3])
             if sample is not None:
                 return sample
         raise ChannelError(f"{self.path}: could not read a consistent sample")
@@ -479,10 +504,12 @@ class ShmChannel(Channel):
                     note = b""
                 if note and note[0] < MAX_WRITERS:
                     i = note[0]
-                    (counter,) = struct.unpack_from("<q", self._mm, _TABLE_OFF + 32 * i)
-                    if not counter & 1:
-                        latest = self._read_slot(i, counter)
-                        if latest is not None and int(latest["time_ns"]) > last_seq:
+                    row = _TABLE_OFF + 8 * _ROW_Q * i
+                    counter, t_ns = _ROW_HEAD.unpack_from(self._mm, row)
+                    if not counter & 1 and t_ns > last_seq:
+                        buffer = _COUNTER.unpack_from(self._mm, row + 32)[0] & 1
+                        latest = self._read_slot(i, counter, buffer)
+                        if latest is not None:
                             self._mm[_WAIT_OFF + self._rslot] = 0
                             return latest
             self._mm[_WAIT_OFF + self._rslot] = 0

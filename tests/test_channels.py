@@ -65,6 +65,19 @@ def _child_write_forever(instance: str, started) -> None:
         k += 1
 
 
+def _child_write_fast(instance: str, duration_s: float) -> None:
+    c = ShmChannel("ref", instance, writer_id=9)
+    s = new_sample(REF_DTYPE)
+    k = 0
+    end = time.monotonic() + duration_s
+    while time.monotonic() < end:
+        k += 1
+        s["ref"][:] = k
+        s["mode"][:] = k % 4
+        c.write(s)
+    c.close()
+
+
 def _child_wait(instance: str, last: int, out) -> None:
     c = ShmChannel("ref", instance)
     s = c.wait_newer(last, 5.0)
@@ -173,7 +186,42 @@ def test_torn_slot_of_a_dead_writer_is_skipped_then_reclaimed(instance):
         c.close()
 
 
+def test_a_writer_caught_mid_copy_hides_nothing(instance):
+    w = ShmChannel("ref", instance)
+    w.write(_ref(1.0))
+    # The next write goes to the other buffer; scribble on it as a preempted writer would.
+    data = ch._DATA_OFF + (w._buffer ^ 1) * w._stride
+    w._mm[data : data + 100] = b"\xff" * 100
+    r = ShmChannel("ref", instance)
+    assert float(r.read_latest()["ref"][0]) == 1.0
+    w.write(_ref(2.0))
+    assert float(r.read_latest()["ref"][39]) == 2.0
+    r.close()
+    w.close()
+
+
 # ---------------------------------------------------------------- real processes
+
+
+def test_no_torn_reads_under_a_fast_writer(instance):
+    r = ShmChannel("ref", instance)
+    p = _run(_child_write_fast, instance, 1.0)
+    seen = 0
+    last = 0
+    end = time.monotonic() + 20.0
+    while time.monotonic() < end and (p.is_alive() or seen == 0):
+        s = r.read_latest()
+        if s is None:
+            continue
+        k = float(s["ref"][0])
+        assert np.all(s["ref"] == k) and np.all(s["mode"] == int(k) % 4)  # one write
+        assert int(s["seq"]) == int(k) and int(s["time_ns"]) >= last
+        last = int(s["time_ns"])
+        seen += 1
+    p.join(20)
+    assert seen > 100
+    r.close()
+
 
 
 def test_two_processes_reader_gets_newest_from_two_writers(instance):
