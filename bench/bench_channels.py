@@ -218,8 +218,9 @@ def measure_latency(n: int = 3000, period_s: float = 0.0005, mechanism: str = "s
             if p.is_alive():
                 p.kill()
         cleanup_stale(instance)
-        for leftover in Path("/tmp/iceoryx2").glob(f"**/hubo-bench-{instance}-*"):
-            leftover.unlink(missing_ok=True)
+        for root, pattern in (("/tmp/iceoryx2", "**/"), ("/dev/shm", "")):
+            for leftover in Path(root).glob(f"{pattern}hubo-bench-{instance}-*"):
+                leftover.unlink(missing_ok=True)  # iceoryx2's files of this run
     return np.asarray(lat[100:], dtype=float) / 1e3  # skip warm-up
 
 
