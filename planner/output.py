@@ -1,0 +1,369 @@
+"""Writing a planned climb: the 40-column trajectory and its ``.plan.json`` sidecar.
+
+`write_plan` times the search result's dense segments (`planner.timing`), writes
+``OUT.traj`` (deterministic: the same result gives the same bytes) and the sidecar:
+per segment the primitive, phase, rung, lines, holds in contact and moving limbs; per
+arm a run-length position/PWM schedule; the final holds; planner metrics, seed, timings
+and version.
+
+PWM (compliant) mode is scheduled for an arm while its hand holds a rail or its palm is
+within `PWM_RAIL_DISTANCE_M` of its rail's axis (closing, opening, the first and last
+centimetres of a reach); position mode while the hand moves through the air.
+"""
+
+from __future__ import annotations
+
+import importlib.metadata
+import logging
+import os
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from robot.plan_sidecar import (
+    HoldRecord,
+    PlanSidecar,
+    Segment,
+    sidecar_path,
+    write_sidecar,
+)
+from robot.trajectory_file import write_trajectory
+
+if TYPE_CHECKING:
+    from planner.contacts import Hold
+    from planner.search import ClimbPlanner, PathSegment, SearchResult
+    from planner.timing import SegmentPath, TimedPlan
+
+log = logging.getLogger(__name__)
+
+__all__ = ["PWM_RAIL_DISTANCE_M", "PlanOutput", "allowed_contacts", "arm_mode_runs",
+           "palm_rail_distances", "planner_version", "segment_paths", "step_groups",
+           "write_plan"]
+
+#: An arm is compliant (PWM) while its palm is this close to its rail's axis [m].
+PWM_RAIL_DISTANCE_M = 0.03
+#: Clearance is measured on every this-many-th line (a distance query is slow).
+CLEARANCE_EVERY_LINES = 20
+ARMS = ("left", "right")
+
+
+@dataclass
+class PlanOutput:
+    """What `write_plan` wrote.
+
+    Attributes:
+        traj_path, sidecar_path: the two files.
+        sidecar: the sidecar as written.
+        timed: the sampled trajectory with each line's segment and configuration.
+        segment_paths: the timed inputs, one per search segment.
+    """
+
+    traj_path: Path
+    sidecar_path: Path
+    sidecar: PlanSidecar = field(repr=False)
+    timed: TimedPlan = field(repr=False)
+    segment_paths: list[SegmentPath] = field(repr=False)
+
+    def __repr__(self) -> str:
+        return (f"PlanOutput({self.traj_path}, {self.sidecar.line_count} lines, "
+                f"{len(self.sidecar.segments)} segments)")
+
+
+def planner_version() -> str:
+    """The installed hubo-ladder version, or ``"unknown"`` from a bare checkout."""
+    try:
+        return importlib.metadata.version("hubo-ladder")
+    except importlib.metadata.PackageNotFoundError:
+        return "unknown"
+
+
+def step_groups(segments: Sequence[PathSegment]) -> list[list[int]]:
+    """Indices of the segments of each step, in order (consecutive segments that share
+    their `Step`)."""
+    groups: list[list[int]] = []
+    for i, seg in enumerate(segments):
+        if groups and segments[groups[-1][-1]].step is seg.step:
+            groups[-1].append(i)
+        else:
+            groups.append([i])
+    return groups
+
+
+def segment_paths(result: SearchResult, kin, q_start: np.ndarray | None = None
+                  ) -> list[SegmentPath]:
+    """The search segments as timing inputs: each path starts where the previous ended.
+
+    Args:
+        result: the search result (segments exclude their start configuration).
+        kin: `HuboKinematics` (columns of a configuration).
+        q_start: the configuration the plan starts from; the first segment's first
+            configuration if None.
+
+    Returns:
+        One `SegmentPath` per segment; the last segment of each step dwells after it.
+    """
+    from planner.timing import SegmentPath
+
+    last_of_step = {g[-1] for g in step_groups(result.segments)}
+    out: list[SegmentPath] = []
+    prev = None if q_start is None else np.asarray(q_start, dtype=float)
+    for i, seg in enumerate(result.segments):
+        configs = [np.asarray(q, dtype=float) for q in seg.configs]
+        if prev is not None:
+            configs = [prev] + configs
+        prev = configs[-1] if configs else prev
+        q = np.array(configs)
+        out.append(SegmentPath(f"{seg.step.label}/{seg.phase}",
+                               np.array([kin.columns(c) for c in q]), q,
+                               dwell_after=i in last_of_step))
+    return out
+
+
+def _record(hold: Hold) -> HoldRecord:
+    return HoldRecord(hold.target, tuple(float(v) for v in hold.T_world_frame[:3, 3]))
+
+
+def _holds_after_steps(result: SearchResult, kin) -> list[dict[str, Hold]]:
+    """The stance after each step, limb → hold.
+
+    The step's last segment has every hold it keeps; a limb placed by the step (a foot,
+    whose last segment is the swing) is read from the next step's segments where it
+    supports, from the final stance after the last step, or else from the limb frame's
+    pose at the end of the step (target from the step's seed hold).
+    """
+    from planner.contacts import LIMB_FRAME, Hold
+
+    segs = result.segments
+    groups = step_groups(segs)
+    out = []
+    for g, idx in enumerate(groups):
+        last = segs[idx[-1]]
+        holds = {h.limb: h for h in last.holds}
+        moved = {limb for i in idx for limb in segs[i].moving_limbs}
+        for limb in sorted(moved - set(holds)):
+            found = None
+            if g + 1 < len(groups):
+                nxt = groups[g + 1]
+                still = {lb for i in nxt for lb in segs[i].moving_limbs}
+                if limb not in still:
+                    found = next((h for i in nxt for h in segs[i].holds if h.limb == limb),
+                                 None)
+            else:
+                found = result.final_stance.hold(limb)
+            if found is None:
+                seed = next((s for s in last.step.new_holds if s.limb == limb), None)
+                if seed is None:
+                    continue
+                q = last.configs[-1]
+                T = kin.frame_pose(q, LIMB_FRAME[limb])
+                found = Hold(limb, seed.target, T, T[:3, 3][None, :], np.array([[0, 0, 1.0]]))
+            holds[limb] = found
+        out.append(holds)
+    return out
+
+
+def palm_rail_distances(configs: np.ndarray, kin, geom) -> dict[str, np.ndarray]:
+    """Distance of each palm to its own side's rail axis, per line [m].
+
+    Args:
+        configs: (N, nq) full configurations.
+        kin: `HuboKinematics` (palm frames ``L_palm``/``R_palm``).
+        geom: `LadderGeometry` (``closest_rail_point``).
+    """
+    out = {}
+    for side in ARMS:
+        frame = "L_palm" if side == "left" else "R_palm"
+        palms = np.array([kin.frame_pose(q, frame)[:3, 3] for q in configs])
+        out[side] = np.linalg.norm(palms - geom.closest_rail_point(side, palms), axis=1)
+    return out
+
+
+def arm_mode_runs(pwm: np.ndarray) -> list[tuple[int, int, str]]:
+    """Run-length schedule of one arm from a per-line PWM flag.
+
+    Args:
+        pwm: (N,) True where the arm is compliant.
+
+    Returns:
+        ``[(first_line, last_line, "position"|"pwm"), ...]``, 1-based inclusive, covering
+        lines 1..N in order.
+    """
+    pwm = np.asarray(pwm, dtype=bool)
+    if pwm.size == 0:
+        return []
+    change = np.flatnonzero(pwm[1:] != pwm[:-1]) + 1
+    starts = np.concatenate([[0], change])
+    ends = np.concatenate([change, [len(pwm)]])
+    return [(int(a) + 1, int(b), "pwm" if pwm[a] else "position") for a, b in zip(starts, ends,
+                                                                                    strict=True)]
+
+
+def allowed_contacts(segments: Sequence[Segment], index: int, fraction: float
+                     ) -> dict[str, str]:
+    """Which environment object each limb may touch at a point of a sidecar segment.
+
+    A held limb touches its hold's target. A moving limb may touch the object it left
+    during the first half of the segment and the one it will hold during the second
+    (a foot lifting off a rung, a hand closing in on a rail).
+
+    Args:
+        segments: the sidecar's segments.
+        index: the segment.
+        fraction: how far into the segment, 0 (first line) to 1 (last line).
+
+    Returns:
+        limb → environment object name (``floor``, ``rung_3``, ``rail_left``...).
+    """
+    seg = segments[index]
+    contacts = {limb: h.target for limb, h in seg.holds.items()}
+    for limb in seg.moving_limbs:
+        before = next((s.holds[limb].target for s in reversed(segments[:index])
+                       if limb in s.holds), None)
+        after = next((s.holds[limb].target for s in segments[index + 1:] if limb in s.holds),
+                     None)
+        choice = (before or after) if fraction < 0.5 else (after or before)
+        if choice is not None:
+            contacts[limb] = choice
+    return contacts
+
+
+def _sidecar_segments(result: SearchResult, timed: TimedPlan,
+                      after: list[dict[str, Hold]]) -> list[Segment]:
+    step_of_segment = {i: g for g, idx in enumerate(step_groups(result.segments)) for i in idx}
+    out: list[Segment] = []
+    key = np.stack([timed.segment_of_line, timed.dwell.astype(int)], axis=1)
+    change = np.flatnonzero(np.any(key[1:] != key[:-1], axis=1)) + 1
+    starts = np.concatenate([[0], change])
+    ends = np.concatenate([change, [timed.line_count]])
+    for a, b in zip(starts, ends, strict=True):
+        seg = result.segments[int(timed.segment_of_line[a])]
+        if timed.dwell[a]:
+            holds = after[step_of_segment[int(timed.segment_of_line[a])]]
+            phase, moving = "dwell", ()
+        else:
+            holds = {h.limb: h for h in seg.holds}
+            phase, moving = seg.phase, tuple(seg.moving_limbs)
+        out.append(Segment(seg.step.primitive.name, phase, int(seg.step.rung), int(a) + 1,
+                           int(b), {limb: _record(h) for limb, h in sorted(holds.items())},
+                           moving))
+    return out
+
+
+def _finite(x: float) -> float | None:
+    return float(x) if np.isfinite(x) else None
+
+
+def _metrics(result: SearchResult, planner: ClimbPlanner, timed: TimedPlan,
+             segments: list[Segment], clearance_every: int) -> dict[str, Any]:
+    stats = result.step_stats
+    per_primitive: dict[str, dict[str, float]] = {}
+    for st in stats:
+        name = st.label.split("@")[0]
+        agg = per_primitive.setdefault(name, {"time_s": 0.0, "samples": 0, "backtracks": 0})
+        agg["time_s"] += st.seconds
+        agg["samples"] += st.samples
+        agg["backtracks"] += st.backtracks
+    clearance, worst_line = np.inf, 0
+    if timed.configs is not None and clearance_every > 0:
+        bounds = np.array([s.first_line for s in segments])
+        for line in range(1, timed.line_count + 1, clearance_every):
+            k = int(np.searchsorted(bounds, line, side="right") - 1)
+            s = segments[k]
+            frac = (line - s.first_line) / max(1, s.last_line - s.first_line)
+            d = planner.checker.clearance(timed.configs[line - 1],
+                                          allowed_contacts(segments, k, frac))
+            if d < clearance:
+                clearance, worst_line = d, line
+    margins = [st.min_margin_m for st in stats if np.isfinite(st.min_margin_m)]
+    return {
+        "min_stability_margin_m": _finite(min(margins)) if margins else None,
+        "max_torque_ratio": max((st.max_torque_ratio for st in stats), default=0.0),
+        "min_clearance_m": _finite(clearance),
+        "min_clearance_line": worst_line,
+        "clearance_every_lines": clearance_every,
+        "duration_s": timed.duration_s,
+        "search_s": result.total_s,
+        "steps": [{"label": st.label, "time_s": st.seconds, "samples": st.samples,
+                   "backtracks": st.backtracks, "min_margin_m": _finite(st.min_margin_m),
+                   "max_torque_ratio": st.max_torque_ratio, "failures": dict(st.failures)}
+                  for st in stats],
+        "primitives": per_primitive,
+    }
+
+
+def write_plan(result: SearchResult, planner: ClimbPlanner, out_traj: str | os.PathLike,
+               rate_hz: float = 200.0, timings: dict[str, float] | None = None, *,
+               dwell_s: float = 0.5, q_start: np.ndarray | None = None,
+               clearance_every: int = CLEARANCE_EVERY_LINES) -> PlanOutput:
+    """Time the plan, write ``OUT.traj`` and ``OUT.plan.json``.
+
+    Args:
+        result: the search result.
+        planner: the planner that produced it (kinematics, ladder geometry, checker,
+            spec, seed).
+        out_traj: path of the trajectory file; the sidecar goes next to it.
+        rate_hz: file rate [Hz].
+        timings: wall times to record in the sidecar [s] (e.g. ``{"search_s": ...}``);
+            the timing and writing times are added.
+        dwell_s: quasi-static hold after each step [s].
+        q_start: configuration before the first segment; the planner's start
+            configuration if None.
+        clearance_every: measure the clearance metric on every n-th line (0: never).
+
+    Returns:
+        What was written.
+
+    Raises:
+        TimingError: a segment could not be timed within the joint limits.
+    """
+    import yaml
+
+    from ladders.loader import ladder_to_yaml
+    from planner.timing import TimingConfig, time_parameterize
+    from robot.limits import joint_limits
+
+    t0 = time.perf_counter()
+    kin = planner.kin
+    if q_start is None:
+        q_start = planner.start_configuration()[0]
+    paths = segment_paths(result, kin, q_start)
+    timed = time_parameterize(paths, joint_limits(kin.params.name),
+                              TimingConfig(rate_hz=rate_hz, dwell_s=dwell_s),
+                              kin.q_index_of_column)
+    t_timed = time.perf_counter()
+    after = _holds_after_steps(result, kin)
+    segments = _sidecar_segments(result, timed, after)
+    distances = palm_rail_distances(timed.configs, kin, planner.geom)
+    arm_modes = {}
+    for side in ARMS:
+        limb = f"{side}_hand"
+        holding = np.zeros(timed.line_count, dtype=bool)
+        for s in segments:
+            h = s.holds.get(limb)
+            if h is not None and h.target.startswith("rail"):
+                holding[s.first_line - 1:s.last_line] = True
+        arm_modes[side] = arm_mode_runs(holding | (distances[side] <= PWM_RAIL_DISTANCE_M))
+    metrics = _metrics(result, planner, timed, segments, clearance_every)
+    metrics["palm_rail_pwm_distance_m"] = PWM_RAIL_DISTANCE_M
+    out_traj = Path(out_traj)
+    write_trajectory(out_traj, timed.columns_rad)
+    all_timings = dict(timings or {})
+    all_timings["timing_s"] = t_timed - t0
+    all_timings["output_s"] = time.perf_counter() - t_timed
+    sidecar = PlanSidecar(
+        robot=kin.params.name, ladder=yaml.safe_load(ladder_to_yaml(planner.spec)),
+        rate_hz=float(rate_hz), line_count=timed.line_count, segments=tuple(segments),
+        arm_modes=arm_modes,
+        final_holds={h.limb: _record(h) for h in sorted(result.final_stance.holds,
+                                                         key=lambda h: h.limb)},
+        seed=int(planner.seed), metrics=metrics, timings_s=all_timings,
+        planner_version=planner_version())
+    side_path = sidecar_path(out_traj)
+    write_sidecar(side_path, sidecar)
+    log.info("wrote %s (%d lines, %.1f s) and %s", out_traj, timed.line_count,
+             timed.duration_s, side_path)
+    return PlanOutput(out_traj, side_path, sidecar, timed, paths)

@@ -1,0 +1,322 @@
+"""Time-parameterising the planner's dense paths into trajectory-file lines (toppra).
+
+Each segment of a plan is a dense path of configurations (consecutive ones within the
+planner's resolution). Its 40 file columns are fitted with a cubic spline over the
+cumulative joint-space distance ``s`` [rad], time-optimally parameterised by toppra
+under the robot's nominal joint velocity and acceleration limits (scaled by
+`TimingConfig.limit_scale`, because sampling the result at 200 Hz slightly exceeds the
+limits it was given), and sampled at the file rate. toppra starts and stops each segment
+at zero path speed, so segments join at rest without a velocity jump. The samples are
+checked against the unscaled limits; if they break one, the segment is timed again with
+limits `RETRY_SCALE` times lower (up to `TimingConfig.retries` times), then
+`TimingError` is raised.
+
+After each step (a stance change) the last line is repeated for a quasi-static dwell.
+
+Every output line keeps the index of the segment it came from, whether it is a dwell
+line, and a full configuration (floating base included, interpolated along ``s`` like
+the joints), which the sidecar's mode schedule needs for palm-to-rail distances.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from robot.errors import HuboLadderError
+from robot.joints import JOINT_NAMES, NUM_JOINTS
+from robot.limits import JointLimits
+
+log = logging.getLogger(__name__)
+
+#: Spline end conditions. "clamped" (zero dq/ds at the ends) bends an arc-length path
+#: into a hook at each end whose curvature toppra only sees at grid points: sampled
+#: accelerations then exceeded the limit by 14 %. The ends are at rest anyway, because
+#: toppra starts and stops with zero path speed.
+BC_TYPE = "not-a-knot"
+#: Limit scale factor applied on each retry.
+RETRY_SCALE = 0.85
+
+__all__ = ["SegmentPath", "TimedPlan", "TimingConfig", "TimingError", "default_config",
+           "time_parameterize"]
+
+
+class TimingError(HuboLadderError):
+    """toppra found no parameterisation, or the sampled file breaks a joint limit."""
+
+
+@dataclass(frozen=True)
+class TimingConfig:
+    """Tunables of the time parameterisation.
+
+    Attributes:
+        rate_hz: file rate: one line every 1 / rate_hz s [Hz].
+        dwell_s: quasi-static hold after each step [s].
+        limit_scale: fraction of the nominal velocity and acceleration limits given to
+            toppra (the samples are checked against the unscaled limits).
+        min_motion_rad: a segment whose path is shorter than this is skipped [rad].
+        tolerance: relative slack of the sample check (float rounding only).
+        retries: re-timings with lower limits when the samples break a limit.
+    """
+
+    rate_hz: float = 200.0
+    dwell_s: float = 0.5
+    limit_scale: float = 0.9
+    min_motion_rad: float = 1e-9
+    tolerance: float = 1e-6
+    retries: int = 2
+
+
+def default_config() -> TimingConfig:
+    """The default timing tunables (200 Hz, 0.5 s dwell, limits ×0.9)."""
+    return TimingConfig()
+
+
+@dataclass
+class SegmentPath:
+    """One segment's dense path, ready for timing.
+
+    Attributes:
+        label: how messages name the segment, e.g. ``moveLHand@rung2/limb``.
+        columns_rad: (M, 40) file columns of the path, its start point included [rad].
+        configs: (M, nq) full configurations matching ``columns_rad`` (pinocchio layout:
+            base xyz [m], base quaternion x y z w, joints [rad]), or None.
+        dwell_after: hold the last line for ``dwell_s`` after this segment (end of a step).
+    """
+
+    label: str
+    columns_rad: np.ndarray = field(repr=False)
+    configs: np.ndarray | None = field(default=None, repr=False)
+    dwell_after: bool = False
+
+
+@dataclass
+class TimedPlan:
+    """The sampled trajectory and where each line came from.
+
+    Attributes:
+        rate_hz: file rate [Hz].
+        columns_rad: (N, 40) lines of the trajectory file [rad].
+        configs: (N, nq) full configuration of each line, or None when the input paths
+            carried none.
+        segment_of_line: (N,) index into the input segment list of each line.
+        dwell: (N,) True for the quasi-static dwell lines after a step.
+        durations_s: segment index → time its motion takes [s] (skipped segments absent).
+        skipped: indices of segments with no motion (no lines).
+    """
+
+    rate_hz: float
+    columns_rad: np.ndarray = field(repr=False)
+    configs: np.ndarray | None = field(repr=False)
+    segment_of_line: np.ndarray = field(repr=False)
+    dwell: np.ndarray = field(repr=False)
+    durations_s: dict[int, float] = field(default_factory=dict)
+    skipped: list[int] = field(default_factory=list)
+
+    @property
+    def line_count(self) -> int:
+        return len(self.columns_rad)
+
+    @property
+    def duration_s(self) -> float:
+        """Playing time of the file, first line at t = 0 [s]."""
+        return (self.line_count - 1) / self.rate_hz
+
+    def __repr__(self) -> str:
+        return (f"TimedPlan({self.line_count} lines at {self.rate_hz:g} Hz = "
+                f"{self.duration_s:.2f} s, {len(self.durations_s)} segments timed, "
+                f"{len(self.skipped)} skipped, {int(self.dwell.sum())} dwell lines)")
+
+
+def _toppra_trajectory(s: np.ndarray, columns: np.ndarray, v_max: np.ndarray,
+                       a_max: np.ndarray):
+    """toppra's time-optimal parameterisation of the spline through ``columns`` over ``s``.
+
+    Returns:
+        The ``ParametrizeConstAccel`` trajectory, or None when toppra found none (toppra
+        reports failure by returning None).
+    """
+    import toppra as ta
+    import toppra.algorithm as algo
+    import toppra.constraint as constraint
+
+    path = ta.SplineInterpolator(s, columns, bc_type=BC_TYPE)
+    # A grid at least as fine as the path's own points: constraints hold on the grid.
+    grid = np.union1d(s, np.linspace(s[0], s[-1], 101))
+    inst = algo.TOPPRA([constraint.JointVelocityConstraint(v_max),
+                        constraint.JointAccelerationConstraint(a_max)], path,
+                       gridpoints=grid, parametrizer="ParametrizeConstAccel")
+    return inst.compute_trajectory(0, 0)
+
+
+def _path_parameter(columns: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Cumulative joint-space distance ``s`` [rad] and the indices of the points kept
+    (points that do not move from their predecessor are dropped: ``s`` must increase)."""
+    step = np.linalg.norm(np.diff(columns, axis=0), axis=1)
+    keep = np.concatenate([[True], step > 1e-12])
+    s = np.concatenate([[0.0], np.cumsum(step)])[keep]
+    return s, np.flatnonzero(keep)
+
+
+def _interpolate_configs(s_way: np.ndarray, configs: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """Configurations at path parameters ``s``: piecewise linear between the dense
+    configurations, the base quaternion normalised (neighbours differ by a few mrad)."""
+    out = np.empty((len(s), configs.shape[1]))
+    for j in range(configs.shape[1]):
+        out[:, j] = np.interp(s, s_way, configs[:, j])
+    quat = out[:, 3:7]
+    quat /= np.linalg.norm(quat, axis=1, keepdims=True)
+    return out
+
+
+def _check_samples(label: str, lines: np.ndarray, rate_hz: float, limits: JointLimits,
+                   tol: float) -> None:
+    """Finite-difference velocity and acceleration of sampled lines against the limits."""
+    if len(lines) < 2:
+        return
+    vel = np.diff(lines, axis=0) * rate_hz
+    ratio = np.abs(vel) / limits.velocity_nominal_rad_s
+    if ratio.max() > 1.0 + tol:
+        k, j = np.unravel_index(int(np.argmax(ratio)), ratio.shape)
+        raise TimingError(f"segment {label}: sample {k + 1} moves {JOINT_NAMES[j]} at "
+                          f"{abs(vel[k, j]):.4g} rad/s, above its nominal limit "
+                          f"{limits.velocity_nominal_rad_s[j]:.4g} rad/s")
+    if len(lines) < 3:
+        return
+    acc = np.diff(lines, n=2, axis=0) * rate_hz**2
+    ratio = np.abs(acc) / limits.accel_nominal_rad_s2
+    if ratio.max() > 1.0 + tol:
+        k, j = np.unravel_index(int(np.argmax(ratio)), ratio.shape)
+        raise TimingError(f"segment {label}: sample {k + 1} accelerates {JOINT_NAMES[j]} at "
+                          f"{abs(acc[k, j]):.4g} rad/s², above its nominal limit "
+                          f"{limits.accel_nominal_rad_s2[j]:.4g} rad/s²")
+
+
+def _time_segment(seg: SegmentPath, limits: JointLimits, cfg: TimingConfig
+                  ) -> tuple[np.ndarray, np.ndarray | None, float] | None:
+    """Sampled lines of one segment (its start point first), their configurations and
+    its duration [s]; None when the segment does not move."""
+    cols = np.asarray(seg.columns_rad, dtype=float)
+    if cols.ndim != 2 or cols.shape[1] != NUM_JOINTS:
+        raise ValueError(f"segment {seg.label}: expected (M, {NUM_JOINTS}) columns, "
+                         f"got shape {cols.shape}")
+    s_all, kept = _path_parameter(cols)
+    if len(s_all) < 2 or s_all[-1] < cfg.min_motion_rad:
+        return None
+    way = cols[kept]
+    scale = cfg.limit_scale
+    for attempt in range(cfg.retries + 1):
+        traj = _toppra_trajectory(s_all, way, scale * limits.velocity_nominal_rad_s,
+                                  scale * limits.accel_nominal_rad_s2)
+        if traj is None:
+            raise TimingError(f"segment {seg.label}: toppra found no time parameterisation "
+                              f"of its {len(way)}-point path ({s_all[-1]:.3f} rad long) "
+                              f"within the velocity and acceleration limits ×{scale:.3g}")
+        duration = float(traj.duration)
+        n = max(1, math.ceil(duration * cfg.rate_hz - 1e-9))
+        # n equal steps of duration / n ≤ 1 / rate: played at the file rate, the motion
+        # is never faster than toppra's.
+        ts = np.linspace(0.0, duration, n + 1)
+        s_t, _, _ = traj._eval_params(ts)  # path parameter of each sample (toppra internal)
+        s_t = np.clip(s_t, 0.0, s_all[-1])
+        lines = np.asarray(traj(ts), dtype=float)
+        lines[0], lines[-1] = way[0], way[-1]  # exact ends: segments join bit for bit
+        # The spline may overshoot a joint limit between points that sit on it.
+        lines = np.clip(lines, limits.lower_rad, limits.upper_rad)
+        try:
+            _check_samples(seg.label, lines, cfg.rate_hz, limits, cfg.tolerance)
+            break
+        except TimingError as exc:
+            if attempt == cfg.retries:
+                raise
+            log.debug("%s; timing again with limits ×%.3g", exc, scale * RETRY_SCALE)
+            scale *= RETRY_SCALE
+    configs = None
+    if seg.configs is not None:
+        configs = _interpolate_configs(s_all, np.asarray(seg.configs, dtype=float)[kept], s_t)
+    return lines, configs, duration
+
+
+def time_parameterize(segments: Sequence[SegmentPath], limits: JointLimits,
+                      config: TimingConfig | None = None,
+                      q_index_of_column: np.ndarray | None = None) -> TimedPlan:
+    """Time every segment and concatenate the samples into file lines.
+
+    Consecutive segments must join: each one's first point is the previous one's last.
+    The first segment's first point becomes line 1; every later segment contributes its
+    samples after that shared point.
+
+    Args:
+        segments: the plan's segments, in order.
+        limits: the robot's joint limits (nominal velocity [rad/s] and acceleration
+            [rad/s²] are used, and positions clip the spline's overshoot).
+        config: rate, dwell and limit scale; `default_config()` if None.
+        q_index_of_column: (40,) index into a configuration of each column (-1 for none);
+            with it, the joints of each line's configuration are the sampled columns
+            themselves rather than interpolated.
+
+    Returns:
+        The timed plan.
+
+    Raises:
+        TimingError: toppra found no parameterisation of a segment, or its samples
+            exceed a nominal limit; the message names the segment.
+    """
+    cfg = config or default_config()
+    if cfg.rate_hz <= 0 or cfg.dwell_s < 0:
+        raise ValueError(f"rate must be > 0 Hz and dwell ≥ 0 s, got {cfg.rate_hz}, "
+                         f"{cfg.dwell_s}")
+    n_dwell = math.ceil(cfg.dwell_s * cfg.rate_hz - 1e-9)
+    lines: list[np.ndarray] = []
+    confs: list[np.ndarray] = []
+    seg_of: list[np.ndarray] = []
+    dwell: list[np.ndarray] = []
+    durations: dict[int, float] = {}
+    skipped: list[int] = []
+    have_configs = all(s.configs is not None for s in segments)
+    for i, seg in enumerate(segments):
+        timed = _time_segment(seg, limits, cfg)
+        if timed is None:
+            skipped.append(i)
+            log.debug("segment %s does not move: skipped", seg.label)
+            if not lines:  # the plan starts here: keep its (only) point as line 1
+                cols = np.asarray(seg.columns_rad, dtype=float)[:1]
+                timed = (cols, None if seg.configs is None
+                         else np.asarray(seg.configs, dtype=float)[:1], 0.0)
+            else:
+                timed = (np.empty((0, NUM_JOINTS)), None, 0.0)
+        else:
+            durations[i] = timed[2]
+        seg_lines, seg_confs, _ = timed
+        if lines and len(seg_lines):
+            seg_lines = seg_lines[1:]  # the shared start point is already the last line
+            seg_confs = None if seg_confs is None else seg_confs[1:]
+        if len(seg_lines):
+            lines.append(seg_lines)
+            seg_of.append(np.full(len(seg_lines), i))
+            dwell.append(np.zeros(len(seg_lines), dtype=bool))
+            if have_configs:
+                confs.append(seg_confs)
+        if seg.dwell_after and n_dwell and lines:
+            lines.append(np.repeat(lines[-1][-1:], n_dwell, axis=0))
+            seg_of.append(np.full(n_dwell, i))
+            dwell.append(np.ones(n_dwell, dtype=bool))
+            if have_configs:
+                confs.append(np.repeat(confs[-1][-1:], n_dwell, axis=0))
+    if not lines:
+        raise TimingError("the plan has no configurations to time")
+    columns = np.vstack(lines)
+    configs = None
+    if have_configs:
+        configs = np.vstack(confs)
+        if q_index_of_column is not None:
+            have = np.asarray(q_index_of_column) >= 0
+            configs[:, np.asarray(q_index_of_column)[have]] = columns[:, have]
+    # The joins (segment ends, dwells) are checked with the whole file.
+    _check_samples("joins", columns, cfg.rate_hz, limits, cfg.tolerance)
+    return TimedPlan(cfg.rate_hz, columns, configs, np.concatenate(seg_of),
+                     np.concatenate(dwell), durations, skipped)
