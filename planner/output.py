@@ -40,7 +40,7 @@ if TYPE_CHECKING:
 
 log = logging.getLogger(__name__)
 
-__all__ = ["PWM_RAIL_DISTANCE_M", "PlanOutput", "allowed_contacts", "arm_mode_runs",
+__all__ = ["PWM_RAIL_DISTANCE_M", "PlanOutput", "arm_mode_runs",
            "palm_rail_distances", "planner_version", "segment_paths", "step_groups",
            "write_plan"]
 
@@ -202,35 +202,6 @@ def arm_mode_runs(pwm: np.ndarray) -> list[tuple[int, int, str]]:
                                                                                     strict=True)]
 
 
-def allowed_contacts(segments: Sequence[Segment], index: int, fraction: float
-                     ) -> dict[str, str]:
-    """Which environment object each limb may touch at a point of a sidecar segment.
-
-    A held limb touches its hold's target. A moving limb may touch the object it left
-    during the first half of the segment and the one it will hold during the second
-    (a foot lifting off a rung, a hand closing in on a rail).
-
-    Args:
-        segments: the sidecar's segments.
-        index: the segment.
-        fraction: how far into the segment, 0 (first line) to 1 (last line).
-
-    Returns:
-        limb → environment object name (``floor``, ``rung_3``, ``rail_left``...).
-    """
-    seg = segments[index]
-    contacts = {limb: h.target for limb, h in seg.holds.items()}
-    for limb in seg.moving_limbs:
-        before = next((s.holds[limb].target for s in reversed(segments[:index])
-                       if limb in s.holds), None)
-        after = next((s.holds[limb].target for s in segments[index + 1:] if limb in s.holds),
-                     None)
-        choice = (before or after) if fraction < 0.5 else (after or before)
-        if choice is not None:
-            contacts[limb] = choice
-    return contacts
-
-
 def _sidecar_segments(result: SearchResult, timed: TimedPlan,
                       after: list[dict[str, Hold]]) -> list[Segment]:
     step_of_segment = {i: g for g, idx in enumerate(step_groups(result.segments)) for i in idx}
@@ -259,6 +230,8 @@ def _finite(x: float) -> float | None:
 
 def _metrics(result: SearchResult, planner: ClimbPlanner, timed: TimedPlan,
              segments: list[Segment], clearance_every: int) -> dict[str, Any]:
+    from planner.check_plan import allowed_contacts  # the verifier's rule, shared
+
     stats = result.step_stats
     per_primitive: dict[str, dict[str, float]] = {}
     for st in stats:
