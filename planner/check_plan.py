@@ -450,10 +450,10 @@ def main(argv: list[str] | None = None) -> int:
         traj = _read(path, rate, robot)
         results = check_plan(traj, sidecar, spec, robot, rate, args.every, str(path))
     except InputError as exc:
-        err.print(f"check-plan: {exc}", markup=False, highlight=False)
+        err.print(f"check-plan: {exc}", markup=False, highlight=False, soft_wrap=True)
         return 2
     except HuboLadderError as exc:
-        err.print(f"check-plan: {exc}", markup=False, highlight=False)
+        err.print(f"check-plan: {exc}", markup=False, highlight=False, soft_wrap=True)
         return 1
     Console().print(_table(results, f"check-plan {path} ({len(traj)} lines, {spec.name}, "
                                     f"{robot})"))
@@ -461,7 +461,7 @@ def main(argv: list[str] | None = None) -> int:
     if failed:
         for r in failed:
             err.print(f"check-plan: {r.name} fails at line {r.worst_line}: {r.detail}",
-                      markup=False, highlight=False)
+                      markup=False, highlight=False, soft_wrap=True)
         return 1
     return 0
 

@@ -1,0 +1,176 @@
+"""``plan-ladder``: plan a climb and write it as a 40-column trajectory plus sidecar.
+
+    plan-ladder LADDER [--robot drc-hubo|hubo2plus] [--seed N] [--rate HZ] [-o OUT.traj]
+                [--time-limit S] [--resolution RAD] [--top-rung K] [--samples N]
+                [--dwell S] [--plots DIR] [-v]
+
+LADDER is a bundled ladder (``drc``, ``ship``, ``stair``) or a spec file. A progress
+bar follows the primitives and rungs; a table summarises each primitive at the end.
+The same seed gives the same trajectory file, byte for byte.
+
+Exit codes: 0 a plan was written; 1 no plan (``no plan: <primitive> at rung <k>:
+<reason>``), or it could not be timed within the joint limits; 2 bad input (the message
+names the file, field or option).
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import sys
+import time
+from pathlib import Path
+
+from robot.errors import HuboLadderError, InputError
+
+__all__ = ["main"]
+
+log = logging.getLogger("plan-ladder")
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="plan-ladder", description=__doc__.split("\n\n")[0])
+    p.add_argument("ladder", help="bundled ladder name (drc, ship, stair) or a spec file")
+    p.add_argument("--robot", default="drc-hubo", choices=("drc-hubo", "hubo2plus"))
+    p.add_argument("--seed", type=int, default=1, help="random seed (default 1)")
+    p.add_argument("--rate", type=float, default=200.0, metavar="HZ",
+                   help="trajectory file rate [Hz] (default 200)")
+    p.add_argument("-o", "--out", metavar="OUT.traj",
+                   help="trajectory file (default: LADDER-NAME.traj); the sidecar "
+                        "OUT.plan.json goes next to it")
+    p.add_argument("--time-limit", type=float, default=600.0, metavar="S",
+                   help="give up planning after this long [s] (default 600)")
+    p.add_argument("--resolution", type=float, default=0.01, metavar="RAD",
+                   help="interpolation resolution [rad] (default 0.01)")
+    p.add_argument("--top-rung", type=int, default=None, metavar="K",
+                   help="climb until both feet stand on rung K (0-based; default: the "
+                        "highest rung the hands can hold rails above)")
+    p.add_argument("--samples", type=int, default=50, metavar="N",
+                   help="samples per step before backtracking (default 50)")
+    p.add_argument("--dwell", type=float, default=0.5, metavar="S",
+                   help="quasi-static hold after each step [s] (default 0.5)")
+    p.add_argument("--plots", metavar="DIR", help="write the CoM/support-region plot of "
+                                                  "each stance into DIR")
+    p.add_argument("-v", "--verbose", action="count", default=0,
+                   help="log planner progress (-vv: every rejected sample)")
+    return p
+
+
+def _check_args(args: argparse.Namespace) -> None:
+    for name, value, ok, rule in (
+            ("--rate", args.rate, args.rate > 0, "> 0 Hz"),
+            ("--time-limit", args.time_limit, args.time_limit > 0, "> 0 s"),
+            ("--resolution", args.resolution, 0 < args.resolution <= 0.5, "in (0, 0.5] rad"),
+            ("--samples", args.samples, args.samples >= 1, "≥ 1"),
+            ("--dwell", args.dwell, args.dwell >= 0, "≥ 0 s")):
+        if not ok:
+            raise InputError(f"option {name} is {value:g}; it must be {rule}")
+
+
+def _summary_table(result, total_s: float, out) -> object:
+    from rich.table import Table
+
+    t = Table(title=f"plan: {len(result.step_stats)} steps, search {result.total_s:.1f} s, "
+                    f"total {total_s:.1f} s, {out.sidecar.line_count} lines "
+                    f"({out.timed.duration_s:.1f} s of motion)")
+    for col in ("primitive", "time [s]", "samples", "backtracks", "min margin [cm]",
+                "max torque ratio"):
+        t.add_column(col, justify="left" if col == "primitive" else "right")
+    for st in result.step_stats:
+        margin = f"{st.min_margin_m * 100:.1f}" if st.min_margin_m != float("inf") else "–"
+        t.add_row(st.label, f"{st.seconds:.2f}", str(st.samples), str(st.backtracks), margin,
+                  f"{st.max_torque_ratio:.2f}")
+    m = out.sidecar.metrics
+    clear = m.get("min_clearance_m")
+    t.caption = (f"min clearance {clear * 100:.1f} cm" if clear is not None else
+                 "min clearance not measured")
+    return t
+
+
+def _plan(args: argparse.Namespace, err) -> int:
+    from rich.console import Console
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        TextColumn,
+        TimeElapsedColumn,
+    )
+
+    from ladders.loader import load_ladder
+    from planner.output import write_plan
+    from planner.search import ClimbPlanner, PlannerConfig, PlanningFailed
+    from primitives.library import climb_sequence
+
+    t0 = time.perf_counter()
+    spec = load_ladder(args.ladder)
+    config = PlannerConfig(samples_per_step=args.samples, resolution_rad=args.resolution,
+                           time_limit_s=args.time_limit)
+    planner = ClimbPlanner(spec, robot=args.robot, config=config, seed=args.seed)
+    top = planner.top_rung() if args.top_rung is None else args.top_rung
+    if not 0 <= top < spec.num_rungs:
+        raise InputError(f"option --top-rung is {top}; ladder '{spec.name}' has rungs "
+                         f"0..{spec.num_rungs - 1}")
+    steps = climb_sequence(top)
+    out_path = Path(args.out) if args.out else Path(f"{spec.name}.traj")
+    with Progress(TextColumn("{task.description:<28}"), BarColumn(), MofNCompleteColumn(),
+                  TimeElapsedColumn(), console=err, transient=False) as progress:
+        step_task = progress.add_task(f"steps: {steps[0].label}", total=len(steps))
+        rung_task = progress.add_task("rungs", total=top + 1)
+
+        def on_step(i: int, n: int, step, stats) -> None:
+            nxt = steps[i + 1].label if i + 1 < n else "done"
+            progress.update(step_task, completed=i + 1, description=f"steps: {nxt}")
+            done_rungs = step.rung + 1 if step.primitive.name == "straighten" else step.rung
+            progress.update(rung_task, completed=done_rungs,
+                            description=f"rungs: at rung {step.rung}")
+            log.info("%s done: %.2f s, %d samples, %d backtracks", step.label, stats.seconds,
+                     stats.samples, stats.backtracks)
+
+        try:
+            result = planner.plan(top_rung=top, progress=on_step)
+        except PlanningFailed as exc:
+            progress.stop()
+            err.print(f"no plan: {exc.step.primitive.name} at rung {exc.step.rung}: "
+                      f"{exc.reason}", markup=False, highlight=False, soft_wrap=True)
+            return 1
+    search_s = time.perf_counter() - t0
+    out = write_plan(result, planner, out_path, args.rate,
+                     {"search_s": result.total_s, "setup_s": search_s - result.total_s},
+                     dwell_s=args.dwell)
+    if args.plots:
+        from planner.plots import write_stance_plots
+
+        files = write_stance_plots(result, planner, args.plots)
+        log.info("wrote %d stance plots into %s", len(files), args.plots)
+    Console().print(_summary_table(result, time.perf_counter() - t0, out))
+    err.print(f"wrote {out.traj_path} and {out.sidecar_path}", highlight=False)
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of ``plan-ladder``; returns the exit code."""
+    from rich.console import Console
+    from rich.logging import RichHandler
+
+    try:
+        args = _parser().parse_args(argv)
+    except SystemExit as exc:  # argparse: --help (0) or a bad option (2)
+        return int(exc.code or 0)
+    err = Console(stderr=True)
+    level = (logging.WARNING, logging.INFO, logging.DEBUG)[min(args.verbose, 2)]
+    logging.basicConfig(level=level, format="%(name)s: %(message)s",
+                        handlers=[RichHandler(console=err, show_time=False)], force=True)
+    try:
+        _check_args(args)
+        return _plan(args, err)
+    except InputError as exc:
+        err.print(f"plan-ladder: {exc}", markup=False, highlight=False, soft_wrap=True)
+        return 2
+    except HuboLadderError as exc:
+        err.print(f"plan-ladder: {exc}", markup=False, highlight=False, soft_wrap=True)
+        return 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,113 @@
+"""Per-stance plots of a plan: the CoM trace against the stance's support region.
+
+One PNG per stance (a set of holds in contact), in the order the plan first uses it:
+the support region polygon (the CoM positions where gravity can be balanced within the
+friction cones), the ground projection of the holds, and the CoM of every configuration
+the plan passes through in that stance. Rendered with matplotlib's Agg backend (no
+display needed).
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+if TYPE_CHECKING:
+    from planner.search import ClimbPlanner, SearchResult
+
+__all__ = ["stance_groups", "write_stance_plots"]
+
+
+def _stance_key(holds) -> tuple:
+    return tuple(sorted((h.limb, h.target, tuple(np.round(h.T_world_frame[:3, 3], 4)))
+                        for h in holds))
+
+
+def stance_groups(result: SearchResult) -> list[tuple[tuple, list[int]]]:
+    """Segments grouped by the stance they are in, in order of first use.
+
+    Returns:
+        ``[(holds, [segment indices])]`` where ``holds`` is the first segment's tuple.
+    """
+    order: dict[tuple, int] = {}
+    groups: list[tuple[tuple, list[int]]] = []
+    for i, seg in enumerate(result.segments):
+        key = _stance_key(seg.holds)
+        if key not in order:
+            order[key] = len(groups)
+            groups.append((tuple(seg.holds), []))
+        groups[order[key]][1].append(i)
+    return groups
+
+
+def _file_name(k: int, label: str) -> str:
+    return f"stance_{k:02d}_{re.sub(r'[^A-Za-z0-9_.-]+', '_', label)}.png"
+
+
+def write_stance_plots(result: SearchResult, planner: ClimbPlanner,
+                       out_dir: str | os.PathLike) -> list[Path]:
+    """Write one CoM-vs-support-region plot per stance into ``out_dir``.
+
+    Args:
+        result: the search result.
+        planner: its planner (kinematics for the CoM, checker for support regions).
+        out_dir: directory, created if missing.
+
+    Returns:
+        The PNG files written.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from planner.contacts import Stance
+
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    written = []
+    for k, (holds, idx) in enumerate(stance_groups(result)):
+        stance = Stance(holds)
+        region = planner.checker.region(stance)
+        com = np.array([planner.kin.com(q) for i in idx for q in result.segments[i].configs])
+        first = result.segments[idx[0]]
+        label = f"{first.step.label}_{first.phase}"
+        fig, ax = plt.subplots(figsize=(5.5, 5.0))
+        if not region.is_empty and len(region.vertices) >= 2:
+            v = np.vstack([region.vertices, region.vertices[:1]])
+            ax.fill(v[:, 0], v[:, 1], alpha=0.2, color="tab:green",
+                    label="support region" + (" (clipped)" if region.clipped else ""))
+            ax.plot(v[:, 0], v[:, 1], color="tab:green", lw=1)
+        for h in holds:
+            pts = np.asarray(h.points_m)
+            ax.scatter(pts[:, 0], pts[:, 1], marker="x" if h.is_hand else "s", s=18,
+                       color="tab:gray")
+            p = h.T_world_frame[:3, 3]
+            ax.annotate(f"{h.limb}\n{h.target}", p[:2], fontsize=6, color="tab:gray")
+        margins = []
+        if len(com):
+            ax.plot(com[:, 0], com[:, 1], color="tab:blue", lw=1.2, label="CoM")
+            ax.scatter(com[:1, 0], com[:1, 1], color="tab:blue", marker="o", s=20,
+                       label="start")
+            ax.scatter(com[-1:, 0], com[-1:, 1], color="tab:red", marker="o", s=20,
+                       label="end")
+            if not region.is_empty:
+                margins = list(np.atleast_1d(region.margin(com)))
+        worst = f", min margin {min(margins) * 100:.1f} cm" if margins else ""
+        ax.set_title(f"{first.step.label} {first.phase}: {len(com)} configurations{worst}",
+                     fontsize=8)
+        ax.set_xlabel("x [m]")
+        ax.set_ylabel("y [m]")
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.grid(True, lw=0.3)
+        ax.legend(fontsize=7, loc="best")
+        path = out / _file_name(k, label)
+        fig.tight_layout()
+        fig.savefig(path, dpi=110)
+        plt.close(fig)
+        written.append(path)
+    return written
