@@ -3,7 +3,10 @@
 Start IK from the seed plus a perturbation that grows with the attempt number; accept a
 result that converged, collides with nothing and is statically stable; if the only
 problem is a collision with the environment, try to retract the body away from the
-ladder (along the rung-line normal) and project again.
+ladder and project again. If the only problem is joint torque (the contacts can balance
+gravity but some joint would exceed its limit), descend the worst torque ratio by a local
+random search over the pelvis position and the posture: on a ladder the feasible set is
+thin (a bent stance knee, 8.9 N·m wrists) and uniform sampling rarely lands in it.
 """
 
 from __future__ import annotations
@@ -59,6 +62,49 @@ class FeasibleSearchStats:
         self.rejections[key] = self.rejections.get(key, 0) + 1
 
 
+#: Torque descent: evaluations per attempt, and step sizes of the pelvis [m] and posture
+#: [rad] perturbations.
+TORQUE_DESCENT_EVALUATIONS = 40
+TORQUE_DESCENT_PELVIS_STEP_M = 0.04
+TORQUE_DESCENT_POSTURE_STEP_RAD = 0.2
+#: Joints whose preference the torque descent also varies: elbows and wrist rolls set
+#: how a hand's load runs through the wrist.
+TORQUE_DESCENT_JOINTS = ("LEB", "REB", "LWR", "RWR")
+
+
+def _descend_torque(kin: HuboKinematics, checker: FeasibilityChecker, q_seed: np.ndarray,
+                    target: SearchTarget, rng: np.random.Generator, q_start: np.ndarray,
+                    ratio: float, posture: dict[str, float], pelvis: np.ndarray | None,
+                    polygon, ik_config: IKConfig, stats: FeasibleSearchStats
+                    ) -> tuple[np.ndarray | None, Verdict | None]:
+    """Local random search that lowers the worst joint-torque ratio until it is ≤ 1."""
+    best_pelvis = q_start[:3].copy() if pelvis is None else pelvis.copy()
+    best_posture = dict(posture)
+    for name in TORQUE_DESCENT_JOINTS:
+        if name not in best_posture and kin.model.existJointName(name):
+            best_posture[name] = float(q_start[kin.model.joints[kin.model.getJointId(name)].idx_q])
+    best_ratio = ratio
+    last = None
+    for _ in range(TORQUE_DESCENT_EVALUATIONS):
+        cand_pelvis = best_pelvis + rng.normal(0.0, TORQUE_DESCENT_PELVIS_STEP_M, 3)
+        cand_posture = {k: v + rng.normal(0.0, TORQUE_DESCENT_POSTURE_STEP_RAD)
+                        for k, v in best_posture.items()}
+        result = solve_ik(kin, q_seed, target.support, target.moving, posture_rad=cand_posture,
+                          torso_R=target.torso_R, pelvis_target_m=cand_pelvis,
+                          pelvis_weight=max(target.pelvis_weight, 1.0), com_polygon_cw=polygon,
+                          config=ik_config)
+        stats.attempts += 1
+        if not result.converged:
+            continue
+        verdict = checker.check(result.q, target.stability_stance, target.contacts)
+        last = verdict
+        if verdict.ok:
+            return result.q, verdict
+        if np.isfinite(verdict.torque_ratio) and verdict.torque_ratio < best_ratio:
+            best_ratio, best_pelvis, best_posture = verdict.torque_ratio, cand_pelvis, cand_posture
+    return None, last
+
+
 def find_feasible(kin: HuboKinematics, checker: FeasibilityChecker, q_seed: np.ndarray,
                   target: SearchTarget, rng: np.random.Generator, *, attempts: int = 10,
                   posture_perturb_rad: float = 0.3, pelvis_perturb_m: float = 0.08,
@@ -97,6 +143,14 @@ def find_feasible(kin: HuboKinematics, checker: FeasibilityChecker, q_seed: np.n
                 return result.q, verdict
             last = verdict
             stats.reject(verdict.reason)
+            if verdict.reason.startswith("torque") and np.isfinite(verdict.torque_ratio):
+                q_ok, v = _descend_torque(kin, checker, q_seed, target, rng, result.q,
+                                          verdict.torque_ratio, posture, pelvis, polygon,
+                                          ik_config, stats)
+                if q_ok is not None:
+                    return q_ok, v
+                last = v or last
+                break
             if not verdict.environment_only:
                 break
             # Retract: pull the pelvis away from the ladder and project again.

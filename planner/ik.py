@@ -79,7 +79,7 @@ def solve_ik(kin: HuboKinematics, q_seed: np.ndarray, support: tuple[Hold, ...],
              moving: tuple[Hold, ...] = (), *, posture_rad: dict[str, float] | None = None,
              torso_R: np.ndarray | None = None, pelvis_target_m: np.ndarray | None = None,
              pelvis_weight: float = 0.0, com_polygon_cw: np.ndarray | None = None,
-             config: IKConfig = IKConfig()) -> IKResult:
+             preferences: bool = True, config: IKConfig = IKConfig()) -> IKResult:
     """Project ``q_seed`` onto the holds and pull the moving limbs to their targets.
 
     Args:
@@ -91,6 +91,8 @@ def solve_ik(kin: HuboKinematics, q_seed: np.ndarray, support: tuple[Hold, ...],
         torso_R: preferred torso orientation (soft), usually facing the ladder, upright.
         pelvis_target_m: preferred pelvis position (soft, ``pelvis_weight``).
         com_polygon_cw: clockwise CoM polygon (k, 2) to stay inside, with margin.
+        preferences: add soft preferences of the holds (hand open side towards the
+            ladder). Off for projections, where only the posture task may pull.
 
     Returns:
         The result; ``converged`` means every hold and target is met within tolerance.
@@ -108,10 +110,10 @@ def solve_ik(kin: HuboKinematics, q_seed: np.ndarray, support: tuple[Hold, ...],
         if name.startswith(FIXED_JOINT_PREFIXES):
             solver.mask_dof(name)
     for hold in support:
-        _add_hold_task(solver, hold, "hard", 1.0, 1.0)
+        _add_hold_task(solver, hold, "hard", 1.0, 1.0, preferences)
     for hold in moving:
         _add_hold_task(solver, hold, "soft", config.moving_position_weight,
-                       config.moving_orientation_weight)
+                       config.moving_orientation_weight, preferences)
     if posture_rad:
         names = {n for n in robot.joint_names()}
         jt = solver.add_joints_task()
@@ -163,7 +165,8 @@ def _errors(kin: HuboKinematics, support, moving, config: IKConfig) -> tuple[flo
     return pos_err, ang_err, ok
 
 
-def _add_hold_task(solver, hold: Hold, priority: str, w_pos: float, w_ori: float) -> None:
+def _add_hold_task(solver, hold: Hold, priority: str, w_pos: float, w_ori: float,
+                   preferences: bool) -> None:
     name = hold.limb
     if hold.is_hand:
         t = solver.add_position_task(hold.frame, hold.T_world_frame[:3, 3].copy())
@@ -171,10 +174,10 @@ def _add_hold_task(solver, hold: Hold, priority: str, w_pos: float, w_ori: float
         a = solver.add_axisalign_task(hold.frame, np.array([1.0, 0.0, 0.0]),
                                       _grip_axis(hold.T_world_frame).copy())
         a.configure(f"{name}_grip_axis", priority, w_ori)
-        # Open side of the hand towards the ladder: soft even for a support hold.
-        b = solver.add_axisalign_task(hold.frame, np.array([0.0, 1.0, 0.0]),
-                                      hold.T_world_frame[:3, 1].copy())
-        b.configure(f"{name}_open_side", "soft", 0.1)
+        if preferences:  # open side of the hand towards the ladder: soft, a preference
+            b = solver.add_axisalign_task(hold.frame, np.array([0.0, 1.0, 0.0]),
+                                          hold.T_world_frame[:3, 1].copy())
+            b.configure(f"{name}_open_side", "soft", 0.1)
     else:
         t = solver.add_frame_task(hold.frame, hold.T_world_frame.copy())
         t.configure(name, priority, w_pos, w_ori)

@@ -20,6 +20,12 @@ from planner.validity import FeasibilityChecker
 
 #: The projection's pull towards the joint-space midpoint (keeps it local).
 MIDPOINT_POSTURE_WEIGHT = 0.1
+#: A moving limb's midpoint target is halfway between its neighbours' actual poses, so it
+#: is reachable: meet it tightly, or tolerance noise keeps the bisection from closing [m].
+PROJECTION_TOL_M = 2e-4
+#: A projected midpoint farther than this fraction of the interval from either end has
+#: jumped to another IK branch: bisection would never close the gap.
+JUMP_RATIO = 0.8
 
 
 class InterpolationError(Exception):
@@ -64,8 +70,6 @@ def contact_space_interpolate(kin: HuboKinematics, checker: FeasibilityChecker,
         InterpolationError: a midpoint did not project or is infeasible.
     """
     stats = stats if stats is not None else InterpolationStats()
-    region = checker.region(stability_stance)
-    polygon = None if region.is_empty else region.clockwise_vertices()
 
     def rec(q0: np.ndarray, q1: np.ndarray, depth: int) -> list[np.ndarray]:
         if kin.joint_distance(q0, q1) <= resolution_rad:
@@ -83,12 +87,21 @@ def contact_space_interpolate(kin: HuboKinematics, checker: FeasibilityChecker,
                    for name in kin.wrapper.joint_names()}
         cfg = IKConfig(**{**ik_config.__dict__, "posture_weight": MIDPOINT_POSTURE_WEIGHT,
                           "torso_upright_weight": 0.0,
-                          "moving_tol_m": ik_config.waypoint_tol_m})
-        res = solve_ik(kin, qm, support, moving_targets, posture_rad=posture,
-                       com_polygon_cw=polygon, config=cfg)
+                          "moving_tol_m": PROJECTION_TOL_M,
+                          "moving_angle_tol_rad": ik_config.angle_tol_rad})
+        # Only restore the contacts, staying near the midpoint; stability is checked after.
+        res = solve_ik(kin, qm, support, moving_targets, posture_rad=posture, preferences=False,
+                       config=cfg)
         stats.projections += 1
         if not res.converged:
             raise InterpolationError(f"projection failed: {res!r}", depth)
+        span = kin.joint_distance(q0, q1)
+        if max(kin.joint_distance(q0, res.q), kin.joint_distance(res.q, q1)) > JUMP_RATIO * span:
+            worst = int(np.argmax(np.abs(res.q[7:] - qm[7:])))
+            raise InterpolationError(
+                f"projection jumped to another IK branch at joint "
+                f"{kin.model.names[worst + 2]} ({qm[7 + worst]:.3f} → {res.q[7 + worst]:.3f} rad)",
+                depth)
         verdict = checker.check(res.q, stability_stance, contacts)
         if not verdict.ok:
             raise InterpolationError(f"midpoint infeasible: {verdict.reason}", depth)
