@@ -1,0 +1,146 @@
+"""planner.output: the trajectory and sidecar of a plan (round trip, mode schedule,
+determinism)."""
+
+from __future__ import annotations
+
+import dataclasses
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+sys.path.insert(0, str(Path(__file__).parent))
+
+from synthetic_plan import synthetic_plan  # noqa: E402
+
+from ladders.loader import parse_ladder_yaml  # noqa: E402
+from planner import output  # noqa: E402
+from planner.contacts import Hold  # noqa: E402
+from planner.output import PWM_RAIL_DISTANCE_M, arm_mode_runs, write_plan  # noqa: E402
+from planner.search import SearchResult  # noqa: E402
+from robot.plan_sidecar import read_sidecar, sidecar_path  # noqa: E402
+from robot.trajectory_file import read_trajectory  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def plan():
+    return synthetic_plan()
+
+
+@pytest.fixture(scope="module")
+def written(plan, tmp_path_factory):
+    planner, result, q0 = plan
+    path = tmp_path_factory.mktemp("out") / "syn.traj"
+    out = write_plan(result, planner, path, 200.0, {"search_s": 1.5}, q_start=q0)
+    return out
+
+
+def test_sidecar_round_trip(plan, written):
+    planner, result, _ = plan
+    sc = read_sidecar(written.sidecar_path)
+    assert written.sidecar_path == sidecar_path(written.traj_path)
+    traj = read_trajectory(written.traj_path, sc.rate_hz, sc.robot)
+    assert sc.line_count == len(traj) == written.timed.line_count
+    assert sc.robot == "drc-hubo" and sc.rate_hz == 200.0 and sc.seed == planner.seed
+    assert parse_ladder_yaml(yaml.safe_dump(sc.ladder)) == planner.spec
+    # Segments tile the file in order.
+    assert sc.segments[0].first_line == 1 and sc.segments[-1].last_line == sc.line_count
+    for a, b in zip(sc.segments, sc.segments[1:], strict=False):
+        assert b.first_line == a.last_line + 1
+    assert [(s.primitive, s.phase, s.rung) for s in sc.segments] == [
+        ("straighten", "body", 0), ("straighten", "dwell", 0), ("straighten", "grasp", 1),
+        ("straighten", "body", 1), ("straighten", "dwell", 1)]
+    feet = {h.limb: h for h in result.final_stance.holds}
+    for seg in sc.segments:
+        assert set(seg.holds) == {"left_foot", "right_foot"}
+        for limb, rec in seg.holds.items():
+            assert rec.target == "floor"
+            np.testing.assert_allclose(rec.position_m, feet[limb].T_world_frame[:3, 3])
+    assert set(sc.final_holds) == {"left_foot", "right_foot"}
+    # Read back equals written (JSON keeps floats exactly).
+    assert sc.segments == written.sidecar.segments
+    assert {k: [tuple(r) for r in v] for k, v in sc.arm_modes.items()} == \
+        written.sidecar.arm_modes
+
+
+def test_sidecar_metrics_and_provenance(written):
+    sc = read_sidecar(written.sidecar_path)
+    m = sc.metrics
+    assert m["min_stability_margin_m"] == pytest.approx(0.04)
+    assert m["max_torque_ratio"] == pytest.approx(0.5)
+    assert 0.0 < m["min_clearance_m"] < 0.5
+    assert m["primitives"]["straighten"] == {"time_s": pytest.approx(0.3), "samples": 8,
+                                             "backtracks": 1}
+    assert [s["label"] for s in m["steps"]] == ["straighten@rung0", "straighten@rung1"]
+    assert m["duration_s"] == pytest.approx((sc.line_count - 1) / 200.0)
+    assert {"search_s", "timing_s", "output_s"} <= set(sc.timings_s)
+    assert sc.planner_version == output.planner_version() != ""
+
+
+def test_hands_in_the_air_are_in_position_mode(written):
+    sc = read_sidecar(written.sidecar_path)
+    assert sc.arm_modes == {"left": [(1, sc.line_count, "position")],
+                            "right": [(1, sc.line_count, "position")]}
+
+
+def test_arm_mode_runs():
+    pwm = np.array([0, 0, 1, 1, 1, 0, 1], dtype=bool)
+    assert arm_mode_runs(pwm) == [(1, 2, "position"), (3, 5, "pwm"), (6, 6, "position"),
+                                  (7, 7, "pwm")]
+    assert arm_mode_runs(np.ones(4, dtype=bool)) == [(1, 4, "pwm")]
+    assert arm_mode_runs(np.zeros(0, dtype=bool)) == []
+
+
+def test_palm_distances_match_the_rail_geometry(plan):
+    planner, result, q0 = plan
+    d = output.palm_rail_distances(np.array([q0]), planner.kin, planner.geom)
+    palm = planner.kin.frame_pose(q0, "L_palm")[:3, 3]
+    expect = np.linalg.norm(palm - planner.geom.closest_rail_point("left", palm))
+    assert d["left"][0] == pytest.approx(expect)
+    assert d["left"][0] > PWM_RAIL_DISTANCE_M  # standing on the floor, hands down
+
+
+def test_mode_schedule_from_palm_distance_and_grasps(plan, tmp_path, monkeypatch):
+    planner, result, q0 = plan
+    # The left palm closes in on its rail over the plan; the right one stays away.
+    def fake(configs, kin, geom):
+        n = len(configs)
+        return {"left": np.linspace(0.10, 0.0, n), "right": np.full(n, 0.2)}
+
+    monkeypatch.setattr(output, "palm_rail_distances", fake)
+    # The grasp segment holds the right rail: PWM there whatever the distance.
+    grasp = result.segments[1]
+    T = np.eye(4)
+    rail = Hold("right_hand", "rail_right", T, np.zeros((2, 3)), np.tile([0, 0, 1.0], (2, 1)))
+    segments = list(result.segments)
+    segments[1] = dataclasses.replace(grasp, holds=grasp.holds + (rail,))
+    res = SearchResult(segments, result.final_stance, result.step_stats, result.total_s)
+    out = write_plan(res, planner, tmp_path / "m.traj", 200.0, q_start=q0, clearance_every=0)
+    sc = read_sidecar(out.sidecar_path)
+    n = sc.line_count
+    first_pwm = int(np.argmax(np.linspace(0.10, 0.0, n) <= PWM_RAIL_DISTANCE_M)) + 1
+    assert sc.arm_modes["left"] == [(1, first_pwm - 1, "position"), (first_pwm, n, "pwm")]
+    g = next(s for s in sc.segments if s.phase == "grasp")
+    assert g.holds["right_hand"].target == "rail_right"
+    assert sc.arm_modes["right"] == [(1, g.first_line - 1, "position"),
+                                     (g.first_line, g.last_line, "pwm"),
+                                     (g.last_line + 1, n, "position")]
+    assert sc.metrics["min_clearance_m"] is None
+
+
+def test_same_input_same_bytes(plan, written, tmp_path):
+    planner, result, q0 = plan
+    again = write_plan(result, planner, tmp_path / "again.traj", 200.0, q_start=q0,
+                       clearance_every=0)
+    assert again.traj_path.read_bytes() == written.traj_path.read_bytes()
+    slower = write_plan(result, planner, tmp_path / "slow.traj", 100.0, q_start=q0,
+                        clearance_every=0)
+    assert slower.traj_path.read_bytes() != written.traj_path.read_bytes()
+
+
+def test_start_configuration_defaults_to_the_planners(plan, written, tmp_path):
+    planner, result, q0 = plan
+    out = write_plan(result, planner, tmp_path / "d.traj", 200.0, clearance_every=0)
+    assert out.traj_path.read_bytes() == written.traj_path.read_bytes()
