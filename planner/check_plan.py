@@ -366,7 +366,7 @@ def check_plan(traj_rad: np.ndarray, sidecar: PlanSidecar, spec, robot: str | No
             res["collision"].offer(line, -d + (1.0 if hit else 0.0), d,
                                    f"{label}: {pair or 'in collision'}", hit)
         res["stability margin"].offer(line, -margin, margin,
-                                      f"{label}: CoM {margin * 100:.1f} cm inside the "
+                                      f"{label}: CoM margin {margin * 100:.1f} cm in the "
                                       f"support region of {', '.join(sorted(seg.holds))}",
                                       margin < 0.0)
         if margin >= 0.0:
@@ -455,14 +455,17 @@ def main(argv: list[str] | None = None) -> int:
     except HuboLadderError as exc:
         err.print(f"check-plan: {exc}", markup=False, highlight=False, soft_wrap=True)
         return 1
-    Console().print(_table(results, f"check-plan {path} ({len(traj)} lines, {spec.name}, "
-                                    f"{robot})"))
+    out = Console()
+    if not out.is_terminal:  # a log file or a pipe: keep each row on one line
+        out = Console(width=200)
+    out.print(_table(results, f"check-plan {path} ({len(traj)} lines, {spec.name}, {robot})"))
     failed = [r for r in results if not r.ok]
     if failed:
         for r in failed:
             err.print(f"check-plan: {r.name} fails at line {r.worst_line}: {r.detail}",
                       markup=False, highlight=False, soft_wrap=True)
         return 1
+    err.print(f"check-plan: all {len(results)} checks pass", highlight=False)
     return 0
 
 

@@ -1,0 +1,123 @@
+"""check-plan: a good plan passes; a moved hold or a joint past its limit fails naming the
+line; bad input exits 2."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).parent))
+
+from synthetic_plan import synthetic_plan  # noqa: E402
+
+from planner.check_plan import CHECKS, allowed_contacts, main  # noqa: E402
+from planner.output import write_plan  # noqa: E402
+from robot.joints import JOINT_INDEX  # noqa: E402
+from robot.limits import joint_limits  # noqa: E402
+from robot.plan_sidecar import HoldRecord, Segment, sidecar_path  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def good(tmp_path_factory) -> Path:
+    planner, result, q0 = synthetic_plan()
+    path = tmp_path_factory.mktemp("plan") / "good.traj"
+    write_plan(result, planner, path, 200.0, q_start=q0, clearance_every=0)
+    return path
+
+
+def _copy(src: Path, dst: Path) -> Path:
+    shutil.copy(src, dst)
+    shutil.copy(sidecar_path(src), sidecar_path(dst))
+    return dst
+
+
+def test_good_plan_passes(good, capsys):
+    assert main([str(good), "--ladder", "drc"]) == 0
+    out = capsys.readouterr().out
+    for check in CHECKS:
+        assert check in out
+    assert "FAIL" not in out
+
+
+def test_moved_hold_fails_naming_the_line(good, tmp_path, capsys):
+    bad = _copy(good, tmp_path / "moved.traj")
+    side = sidecar_path(bad)
+    d = json.loads(side.read_text())
+    seg = d["segments"][3]  # the rise: right foot said to stand 5 cm further forward
+    seg["holds"]["right_foot"]["position_m"][0] += 0.05
+    side.write_text(json.dumps(d))
+    assert main([str(bad), "--ladder", "drc", "--every", "50"]) == 1
+    err = capsys.readouterr().err
+    line = int(err.split("holds fails at line ")[1].split(":")[0])
+    assert seg["first_line"] <= line <= seg["last_line"]
+    assert "right_foot 5.00 cm from its hold on floor" in err
+
+
+def test_joint_past_its_limit_fails_naming_the_line(good, tmp_path, capsys):
+    bad = _copy(good, tmp_path / "limit.traj")
+    lines = bad.read_text().splitlines()
+    cols = lines[99].split()
+    k = JOINT_INDEX["RKN"]
+    cols[k] = repr(float(joint_limits().upper_rad[k]) + 0.2)
+    lines[99] = " ".join(cols)
+    bad.write_text("\n".join(lines) + "\n")
+    assert main([str(bad), "--every", "50"]) == 1
+    err = capsys.readouterr().err
+    assert "joint limits fails at line 100: RKN" in err
+    assert "velocity fails at line 100" in err
+
+
+def test_bad_input_exits_2(good, tmp_path, capsys):
+    lone = tmp_path / "lone.traj"
+    shutil.copy(good, lone)
+    assert main([str(lone)]) == 2
+    assert "sidecar" in capsys.readouterr().err
+    broken = _copy(good, tmp_path / "broken.traj")
+    lines = broken.read_text().splitlines()
+    lines[6] = lines[6].replace(" ", " oops ", 1)
+    broken.write_text("\n".join(lines) + "\n")
+    assert main([str(broken)]) == 2
+    assert f"{broken}:7:" in capsys.readouterr().err
+    short = _copy(good, tmp_path / "short.traj")
+    short.write_text("".join(short.read_text().splitlines(keepends=True)[:-5]))
+    assert main([str(short)]) == 2
+    assert "line_count" in capsys.readouterr().err
+    assert main([str(good), "--ladder", "nosuch"]) == 2
+    assert "unknown ladder 'nosuch'" in capsys.readouterr().err
+    assert main([str(good), "--every", "0"]) == 2
+
+
+def test_moving_limbs_may_touch_what_they_leave_then_what_they_reach():
+    def seg(holds, moving=()):
+        return Segment("moveLFoot", "limb", 0, 1, 1,
+                       {lb: HoldRecord(t, (0.0, 0.0, 0.0)) for lb, t in holds.items()},
+                       moving)
+
+    segs = [seg({"left_foot": "rung_0", "right_foot": "rung_0"}),
+            seg({"right_foot": "rung_0"}, ("left_foot",)),
+            seg({"left_foot": "rung_1", "right_foot": "rung_0"})]
+    assert allowed_contacts(segs, 1, 0.2) == {"right_foot": "rung_0", "left_foot": "rung_0"}
+    assert allowed_contacts(segs, 1, 0.8) == {"right_foot": "rung_0", "left_foot": "rung_1"}
+    assert allowed_contacts(segs[:2], 1, 0.8)["left_foot"] == "rung_0"
+    assert allowed_contacts(segs, 0, 0.5) == {"left_foot": "rung_0", "right_foot": "rung_0"}
+
+
+def test_collision_is_reported(good, tmp_path, capsys):
+    # Fold the standing (left) leg: the body drops and the right shin goes into the floor.
+    bad = _copy(good, tmp_path / "floor.traj")
+    q = np.loadtxt(bad)
+    for j, v in (("LHP", -1.4), ("LKN", 2.5)):
+        q[-1, JOINT_INDEX[j]] = v
+    from robot.trajectory_file import format_trajectory
+
+    bad.write_text(format_trajectory(q))
+    assert main([str(bad), "--every", "100"]) == 1
+    err = capsys.readouterr().err
+    assert f"collision fails at line {len(q)}" in err
+    assert "floor" in err.split("collision fails")[1].splitlines()[0]
+    assert f"stability margin fails at line {len(q)}" in err
