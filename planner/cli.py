@@ -143,8 +143,11 @@ def _plan(args: argparse.Namespace, err) -> int:
 
         files = write_stance_plots(result, planner, args.plots)
         log.info("wrote %d stance plots into %s", len(files), args.plots)
-    Console().print(_summary_table(result, time.perf_counter() - t0, out))
-    err.print(f"wrote {out.traj_path} and {out.sidecar_path}", highlight=False)
+    console = Console()
+    if not console.is_terminal:  # a log file or a pipe: keep each row on one line
+        console = Console(width=200)
+    console.print(_summary_table(result, time.perf_counter() - t0, out))
+    err.print(f"wrote {out.traj_path} and {out.sidecar_path}", highlight=False, soft_wrap=True)
     return 0
 
 

