@@ -104,7 +104,7 @@ def write_stance_plots(result: SearchResult, planner: ClimbPlanner,
         ax.set_ylabel("y [m]")
         ax.set_aspect("equal", adjustable="datalim")
         ax.grid(True, lw=0.3)
-        ax.legend(fontsize=7, loc="best")
+        ax.legend(fontsize=7, loc="lower left", framealpha=0.6)
         path = out / _file_name(k, label)
         fig.tight_layout()
         fig.savefig(path, dpi=110)

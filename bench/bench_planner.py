@@ -1,0 +1,101 @@
+"""Benchmark: planning time and success of the climb search (issue 3 targets).
+
+- median planning time per rung ≤ 5 s (search time of the steps that climb one rung:
+  both hands up, both feet up, straighten; the mount counts as rung 0);
+- a whole DRC ladder ≤ 60 s on one core (seed 1);
+- planner success over seeds ≥ 95 % (quick: seeds 1–3 on ``drc``; ``full=True`` or
+  ``HUBO_BENCH_FULL=1``: seeds 1–20 on every bundled ladder).
+
+Each plan is capped at `TIME_LIMIT_S` (quick) or `FULL_TIME_LIMIT_S` (full); a capped
+run counts as a failure. Run with ``.venv/bin/python bench/bench_planner.py``.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import statistics
+import time
+
+TARGET_PER_RUNG_S = 5.0
+TARGET_LADDER_S = 60.0
+TARGET_SUCCESS = 0.95
+#: Per-plan time cap [s]: twice the whole-ladder target, so a slow success still counts.
+TIME_LIMIT_S = 120.0
+FULL_TIME_LIMIT_S = 600.0
+QUICK = {"drc": (1, 2, 3)}
+FULL_SEEDS = tuple(range(1, 21))
+
+log = logging.getLogger(__name__)
+
+
+def _plan_once(ladder: str, seed: int, time_limit_s: float) -> dict:
+    """One full-ladder plan: success, wall time [s], search seconds per rung."""
+    from ladders.loader import load_ladder
+    from planner.search import ClimbPlanner, PlannerConfig, PlanningFailed
+    from robot.errors import HuboLadderError
+
+    t0 = time.perf_counter()
+    planner = ClimbPlanner(load_ladder(ladder), config=PlannerConfig(time_limit_s=time_limit_s),
+                           seed=seed)
+    try:
+        result = planner.plan()
+    except PlanningFailed as exc:
+        return {"ok": False, "wall_s": time.perf_counter() - t0,
+                "why": f"{exc.step.label}: {exc.reason}", "per_rung_s": {}}
+    except HuboLadderError as exc:
+        return {"ok": False, "wall_s": time.perf_counter() - t0, "why": str(exc),
+                "per_rung_s": {}}
+    per_rung: dict[int, float] = {}
+    for st in result.step_stats:
+        rung = int(st.label.rsplit("rung", 1)[1])
+        per_rung[rung] = per_rung.get(rung, 0.0) + st.seconds
+    return {"ok": True, "wall_s": time.perf_counter() - t0, "why": "",
+            "per_rung_s": per_rung, "search_s": result.total_s}
+
+
+def run(full: bool | None = None) -> list[dict]:
+    """Plan each (ladder, seed) and report the three figures against their targets.
+
+    Args:
+        full: seeds 1–20 on every bundled ladder; default from ``HUBO_BENCH_FULL``.
+    """
+    from ladders.loader import BUNDLED_LADDERS
+
+    if full is None:
+        full = bool(os.environ.get("HUBO_BENCH_FULL"))
+    plan = {name: FULL_SEEDS for name in BUNDLED_LADDERS} if full else QUICK
+    limit = FULL_TIME_LIMIT_S if full else TIME_LIMIT_S
+    runs = {(ladder, seed): _plan_once(ladder, seed, limit)
+            for ladder, seeds in plan.items() for seed in seeds}
+    for (ladder, seed), r in runs.items():
+        log.info("%s seed %d: %s in %.1f s %s", ladder, seed, "ok" if r["ok"] else "FAILED",
+                 r["wall_s"], r["why"])
+    mode = "full" if full else "quick"
+    out = []
+    per_rung = [s for r in runs.values() for s in r["per_rung_s"].values()]
+    med = statistics.median(per_rung) if per_rung else None
+    out.append({"name": f"planner_median_time_per_rung_{mode}", "value":
+                None if med is None else round(med, 2), "unit": "s",
+                "target": f"<= {TARGET_PER_RUNG_S:g}",
+                "ok": med is not None and med <= TARGET_PER_RUNG_S})
+    drc1 = runs.get(("drc", 1))
+    whole = round(drc1["search_s"], 1) if drc1 and drc1["ok"] else None
+    out.append({"name": "planner_whole_drc_ladder_seed1", "value": whole, "unit": "s",
+                "target": f"<= {TARGET_LADDER_S:g}",
+                "ok": whole is not None and whole <= TARGET_LADDER_S})
+    for ladder in plan:
+        mine = [r for (lad, _), r in runs.items() if lad == ladder]
+        rate = sum(r["ok"] for r in mine) / len(mine)
+        first_failure = next((r["why"] for r in mine if not r["ok"]), "")
+        out.append({"name": f"planner_success_{ladder}_{len(mine)}_seeds", "value":
+                    round(rate, 3), "unit": "fraction", "target": f">= {TARGET_SUCCESS:g}",
+                    "ok": rate >= TARGET_SUCCESS,
+                    **({"note": first_failure[:200]} if first_failure else {})})
+    return out
+
+
+if __name__ == "__main__":
+    logging.basicConfig(level=logging.INFO, format="%(message)s")
+    for row in run():
+        print(row)
