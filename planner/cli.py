@@ -16,8 +16,11 @@ names the file, field or option).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import logging
+import signal
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -65,6 +68,35 @@ def _check_args(args: argparse.Namespace) -> None:
             ("--dwell", args.dwell, args.dwell >= 0, "≥ 0 s")):
         if not ok:
             raise InputError(f"option {name} is {value:g}; it must be {rule}")
+
+
+#: The search checks its time limit between samples; a sample can take seconds. The CLI
+#: stops it this long after the limit regardless [s].
+HARD_LIMIT_GRACE_S = 0.5
+
+
+class _TimeUp(Exception):
+    """Raised by the alarm signal when the planning time is over."""
+
+
+@contextlib.contextmanager
+def _hard_time_limit(seconds: float):
+    """Raise `_TimeUp` in the main thread after ``seconds`` (no-op off the main thread)."""
+    if threading.current_thread() is not threading.main_thread() or \
+            not hasattr(signal, "setitimer"):
+        yield
+        return
+
+    def on_alarm(signum, frame):
+        raise _TimeUp
+
+    previous = signal.signal(signal.SIGALRM, on_alarm)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
 
 
 def _summary_table(result, total_s: float, out) -> object:
@@ -118,7 +150,10 @@ def _plan(args: argparse.Namespace, err) -> int:
         step_task = progress.add_task(f"steps: {steps[0].label}", total=len(steps))
         rung_task = progress.add_task("rungs", total=top + 1)
 
+        current = [steps[0]]  # the step being searched, for the time-out message
+
         def on_step(i: int, n: int, step, stats) -> None:
+            current[0] = steps[min(i + 1, n - 1)]
             nxt = steps[i + 1].label if i + 1 < n else "done"
             progress.update(step_task, completed=i + 1, description=f"steps: {nxt}")
             done_rungs = step.rung + 1 if step.primitive.name == "straighten" else step.rung
@@ -128,11 +163,14 @@ def _plan(args: argparse.Namespace, err) -> int:
                      stats.samples, stats.backtracks)
 
         try:
-            result = planner.plan(top_rung=top, progress=on_step)
-        except PlanningFailed as exc:
+            with _hard_time_limit(args.time_limit + HARD_LIMIT_GRACE_S):
+                result = planner.plan(top_rung=top, progress=on_step)
+        except (PlanningFailed, _TimeUp) as exc:
             progress.stop()
-            err.print(f"no plan: {exc.step.primitive.name} at rung {exc.step.rung}: "
-                      f"{exc.reason}", markup=False, highlight=False, soft_wrap=True)
+            step, reason = ((exc.step, exc.reason) if isinstance(exc, PlanningFailed) else
+                            (current[0], f"time limit of {args.time_limit:g} s reached"))
+            err.print(f"no plan: {step.primitive.name} at rung {step.rung}: {reason}",
+                      markup=False, highlight=False, soft_wrap=True)
             return 1
     search_s = time.perf_counter() - t0
     out = write_plan(result, planner, out_path, args.rate,
