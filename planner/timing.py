@@ -176,24 +176,17 @@ def _interpolate_configs(s_way: np.ndarray, configs: np.ndarray, s: np.ndarray) 
 def _check_samples(label: str, lines: np.ndarray, rate_hz: float, limits: JointLimits,
                    tol: float) -> None:
     """Finite-difference velocity and acceleration of sampled lines against the limits."""
-    if len(lines) < 2:
-        return
-    vel = np.diff(lines, axis=0) * rate_hz
-    ratio = np.abs(vel) / limits.velocity_nominal_rad_s
-    if ratio.max() > 1.0 + tol:
-        k, j = np.unravel_index(int(np.argmax(ratio)), ratio.shape)
-        raise TimingError(f"segment {label}: sample {k + 1} moves {JOINT_NAMES[j]} at "
-                          f"{abs(vel[k, j]):.4g} rad/s, above its nominal limit "
-                          f"{limits.velocity_nominal_rad_s[j]:.4g} rad/s")
-    if len(lines) < 3:
-        return
-    acc = np.diff(lines, n=2, axis=0) * rate_hz**2
-    ratio = np.abs(acc) / limits.accel_nominal_rad_s2
-    if ratio.max() > 1.0 + tol:
-        k, j = np.unravel_index(int(np.argmax(ratio)), ratio.shape)
-        raise TimingError(f"segment {label}: sample {k + 1} accelerates {JOINT_NAMES[j]} at "
-                          f"{abs(acc[k, j]):.4g} rad/s², above its nominal limit "
-                          f"{limits.accel_nominal_rad_s2[j]:.4g} rad/s²")
+    for order, limit, verb, unit in ((1, limits.velocity_nominal_rad_s, "moves", "rad/s"),
+                                     (2, limits.accel_nominal_rad_s2, "accelerates", "rad/s²")):
+        if len(lines) <= order:
+            return
+        rate = np.abs(np.diff(lines, n=order, axis=0)) * rate_hz**order
+        ratio = rate / limit
+        if ratio.max() > 1.0 + tol:
+            k, j = np.unravel_index(int(np.argmax(ratio)), ratio.shape)
+            raise TimingError(f"segment {label}: sample {k + 1} {verb} {JOINT_NAMES[j]} at "
+                              f"{rate[k, j]:.4g} {unit}, above its nominal limit "
+                              f"{limit[j]:.4g} {unit}")
 
 
 def _time_segment(seg: SegmentPath, limits: JointLimits, cfg: TimingConfig
