@@ -96,7 +96,7 @@ class _BusSim:
         pwm = e._pwm[idx]
         alpha = 1.0 - math.exp(-dt / cfg.lag_s)
         pos = e._pos_rad[idx]
-        target = np.where(pwm, pos + e._duty[idx] * cfg.rad_s_per_pct * dt, pos)
+        target = np.where(pwm, pos - e._duty[idx] * cfg.rad_s_per_pct * dt, pos)  # hubo-ach sign
         target = np.where(pwm, target, pos + (e._ref_rad[idx] - pos) * alpha)
         e._pos_rad[idx] = target
 

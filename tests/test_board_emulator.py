@@ -79,7 +79,7 @@ def test_pwm_moves_at_a_velocity(rig):
     mask = np.zeros(40, bool)
     mask[t["RSP"].index] = True
     duty = np.zeros(40)
-    duty[t["RSP"].index] = 50.0  # 50 % × 0.02 rad/s/% = 1 rad/s
+    duty[t["RSP"].index] = -50.0  # −50 % × 0.02 rad/s/% = +1 rad/s (hubo-ach sign)
     _cycle(buses, plan.encode(np.zeros(40), duty, mask), 0.0)
     time.sleep(0.2)
     _cycle(buses, {1: [cp.encode_enc_request(8)]}, 0.01)
