@@ -42,6 +42,7 @@ seen. Writers (``hubo-console``) wait for the next ticks before sending another.
 from __future__ import annotations
 
 import logging
+import os
 import threading
 import time
 from collections.abc import Callable
@@ -74,6 +75,7 @@ __all__ = [
     "LoopStats",
     "SensorFrame",
     "default_config",
+    "set_realtime_priority",
     "sleep_until_ns",
 ]
 
@@ -252,6 +254,19 @@ class LoopStats:
     starts_ns: list[int] = field(default_factory=list)  # with record_starts
 
 
+def set_realtime_priority(priority: int) -> str | None:
+    """Ask for ``SCHED_FIFO`` at ``priority`` (1..99) for this process.
+
+    Returns:
+        None when granted, else why not (no privilege, unsupported OS).
+    """
+    try:
+        os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(priority))
+    except (OSError, AttributeError, ValueError) as exc:
+        return str(exc)
+    return None
+
+
 def sleep_until_ns(t_ns: int) -> None:
     """Sleep until ``CLOCK_MONOTONIC`` reaches ``t_ns`` [ns]."""
     while True:
@@ -309,6 +324,16 @@ class DaemonLoop:
         self._last_cmd_ns = 0
         self._last_gains_ns = 0
         self.last_sensors: SensorFrame | None = None
+
+    @property
+    def state(self) -> np.ndarray:
+        """The state sample of the last tick (a view: copy it to keep it)."""
+        return self._state
+
+    @property
+    def holding(self) -> bool:
+        """The watchdog holds the joints (stale reference while playing)."""
+        return self._watchdog
 
     # ------------------------------------------------------------------ run
     def start(self, now_ns: int | None = None) -> None:

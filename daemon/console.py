@@ -1,0 +1,246 @@
+"""``hubo-console``: hubo-ach's console, one command per line on stdin.
+
+    hubo-console [--instance NAME] [-c "CMD; CMD; ..."]
+
+Commands (joint ``J`` by name, ``RSP``, or by 0-based index; names are case-insensitive):
+
+==================  ===========================================================
+``homeAll``         home every joint (references ignored for 3 s)
+``home J``          home one joint
+``goto J RAD``      position mode, reference RAD [rad] (filtered), others unchanged
+``comp J RAD``      compliant (PWM) around RAD [rad]
+``kp J V``          PWM proportional gain [%/rad], ``0 <= V < 70``
+``kd J V``          PWM damping gain [%/(rad/s)], ``0 <= V < 10``
+``maxPWM J V``      PWM duty clamp [%], ``0 <= V < 8``
+``status J``        one joint's state
+``statusAll``       every joint's state
+``iniSensors``      zero the FT and IMU offsets (robot hanging still)
+``reset J``         reset a joint's board (clears a trip)
+``quit``            leave
+==================  ===========================================================
+
+Gains outside the thesis manual's safety limits are refused here with their range, and
+nothing is sent (the daemon refuses them too). Each command waits until the daemon has
+ticked past it, so consecutive commands are never lost on the latest-value channel.
+
+Exit codes: 0 every command done, 1 the daemon did not answer, 2 a command was refused
+(unknown command or joint, a value out of range).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+import time
+
+import numpy as np
+
+from robot.errors import HuboLadderError, InputError
+
+__all__ = ["Console", "main"]
+
+ACK_TIMEOUT_S = 1.0  # wait at most this for the daemon to tick past a command [s]
+_GAIN_COMMANDS = {"kp": ("kp", 0), "kd": ("kd", 1), "maxpwm": ("max_pwm_pct", 2)}
+
+
+def _joint(token: str) -> int:
+    from robot.joints import JOINT_INDEX, JOINT_NAMES, NUM_JOINTS
+
+    name = token.upper()
+    if name in JOINT_INDEX:
+        return JOINT_INDEX[name]
+    if token.isdigit() and int(token) < NUM_JOINTS:
+        return int(token)
+    raise InputError(f"unknown joint {token!r}; valid: 0..{NUM_JOINTS - 1} or "
+                     f"{' '.join(JOINT_NAMES)}")
+
+
+def _number(token: str, what: str) -> float:
+    try:
+        v = float(token)
+    except ValueError:
+        v = math.nan
+    if not math.isfinite(v):
+        raise InputError(f"{what} {token!r} is not a finite number")
+    return v
+
+
+def format_joint(s: np.ndarray, j: int) -> str:
+    """One joint of a state sample as a line."""
+    from daemon.structs import StatusFlag
+    from robot.joints import JOINT_NAMES
+
+    flags = StatusFlag(int(s["status"][j]))
+    names = "|".join(f.name for f in StatusFlag if f and f in flags) or "OK"
+    return (f"{JOINT_NAMES[j]:4s} ref {s['ref'][j]:+8.4f}  pos {s['pos'][j]:+8.4f}  "
+            f"vel {s['vel'][j]:+7.3f}  cur {s['cur'][j]:6.2f} A  duty {s['duty'][j]:+5.1f} %  "
+            f"comply {int(s['comply'][j])}  active {int(s['active'][j])}  "
+            f"zeroed {int(s['zeroed'][j])}  {names}")
+
+
+class Console:
+    """The console's commands on one daemon instance (see the module docstring)."""
+
+    def __init__(self, instance: str = "default", out=sys.stdout, err=sys.stderr):
+        from daemon.channels import open_channel
+
+        self.instance = instance
+        self.out, self.err = out, err
+        self.cmd = open_channel("board-cmd", instance)
+        self.ref = open_channel("ref", instance)
+        self.state = open_channel("state", instance)
+
+    def close(self) -> None:
+        for c in (self.cmd, self.ref, self.state):
+            c.close()
+
+    def _state(self) -> np.ndarray:
+        s = self.state.read_latest()
+        if s is None or time.monotonic_ns() - int(s["time_ns"]) > 500_000_000:
+            raise HuboLadderError(f"no hubo-daemon is ticking on instance {self.instance!r}")
+        return s
+
+    def _wait_ticks(self, since: np.ndarray, ticks: int = 2) -> None:
+        target = int(since["tick"]) + ticks
+        deadline = time.monotonic() + ACK_TIMEOUT_S
+        s = since
+        while int(s["tick"]) < target:
+            left = deadline - time.monotonic()
+            if left <= 0:
+                raise HuboLadderError("the daemon did not tick past the command in "
+                                      f"{ACK_TIMEOUT_S:g} s")
+            s = self.state.wait_newer(int(s["time_ns"]), left) or s
+
+    def board_command(self, kind, joint: int = -1, params=(), dvalues=()) -> None:
+        """Send one board command and wait until the daemon has seen it."""
+        from daemon.structs import BOARD_CMD_DTYPE, new_sample
+
+        before = self._state()
+        c = new_sample(BOARD_CMD_DTYPE)
+        c["type"], c["joint"] = int(kind), joint
+        c["params"][: len(params)] = params
+        c["dvalues"][: len(dvalues)] = dvalues
+        self.cmd.write(c)
+        self._wait_ticks(before)
+
+    def reference(self, joint: int, rad: float, comply: bool) -> None:
+        """Command one joint to ``rad`` [rad], every other joint where it is."""
+        from daemon.control_modes import RefMode
+        from daemon.structs import REF_DTYPE, new_sample
+
+        before = self._state()
+        r = new_sample(REF_DTYPE)
+        r["ref"] = before["ref"]
+        r["comply"] = before["comply"]
+        r["mode"] = RefMode.FILTER
+        r["ref"][joint] = rad
+        r["comply"][joint] = comply
+        r["playing"] = 0
+        self.ref.write(r)
+        self._wait_ticks(before)
+
+    def execute(self, line: str) -> bool:
+        """Run one command line; False on ``quit``.
+
+        Raises:
+            InputError: unknown command, joint or a value out of range (nothing sent).
+            HuboLadderError: the daemon did not answer.
+        """
+        from daemon.pwm import GAIN_LIMITS
+        from daemon.structs import BoardCommandType as T
+
+        words = line.split("#", 1)[0].split()
+        if not words:
+            return True
+        cmd, rest = words[0].lower(), words[1:]
+        need = {"homeall": 0, "home": 1, "goto": 2, "comp": 2, "kp": 2, "kd": 2, "maxpwm": 2,
+                "status": 1, "statusall": 0, "inisensors": 0, "reset": 1, "quit": 0,
+                "exit": 0, "help": 0}
+        if cmd not in need:
+            raise InputError(f"unknown command {words[0]!r}; commands: homeAll, home J, "
+                             "goto J rad, comp J rad, kp J v, kd J v, maxPWM J v, status J, "
+                             "statusAll, iniSensors, reset J, quit")
+        if len(rest) != need[cmd]:
+            raise InputError(f"{words[0]} takes {need[cmd]} argument(s), got {len(rest)}")
+        if cmd in ("quit", "exit"):
+            return False
+        if cmd == "help":
+            print(__doc__.split("\n\n")[2], file=self.out)
+        elif cmd == "homeall":
+            self.board_command(T.HOME_ALL)
+            print("homing every joint (references ignored for 3 s)", file=self.out)
+        elif cmd == "home":
+            j = _joint(rest[0])
+            self.board_command(T.HOME, j)
+        elif cmd in ("goto", "comp"):
+            j = _joint(rest[0])
+            self.reference(j, _number(rest[1], "position"), cmd == "comp")
+        elif cmd in _GAIN_COMMANDS:
+            from robot.joints import JOINT_NAMES
+
+            j = _joint(rest[0])
+            field, bit = _GAIN_COMMANDS[cmd]
+            v = _number(rest[1], words[0])
+            limit = GAIN_LIMITS[field]
+            if not limit.contains(np.array([v]))[0]:
+                raise InputError(f"{words[0]} {v:g} for {JOINT_NAMES[j]} refused: allowed "
+                                 f"{limit} (thesis manual: kp < 70, kd < 10, max_pwm < 8)")
+            dvalues = [0.0, 0.0, 0.0]
+            dvalues[bit] = v
+            self.board_command(T.SET_GAINS, j, params=[1 << bit], dvalues=dvalues)
+        elif cmd == "status":
+            print(format_joint(self._state(), _joint(rest[0])), file=self.out)
+        elif cmd == "statusall":
+            s = self._state()
+            print(f"tick {int(s['tick'])}  overruns {int(s['overruns'])}  "
+                  f"t {float(s['time_s']):.2f} s", file=self.out)
+            for j in range(len(s["ref"])):
+                print(format_joint(s, j), file=self.out)
+        elif cmd == "inisensors":
+            self.board_command(T.INIT_SENSORS)
+        elif cmd == "reset":
+            self.board_command(T.RESET, _joint(rest[0]))
+        return True
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of ``hubo-console``; returns the exit code."""
+    p = argparse.ArgumentParser(prog="hubo-console", description=__doc__.split("\n\n")[0])
+    p.add_argument("--instance", default="default", help="daemon instance (default)")
+    p.add_argument("-c", dest="commands", metavar="CMDS",
+                   help="run these ';'-separated commands instead of reading stdin")
+    args = p.parse_args(argv)
+    lines = args.commands.split(";") if args.commands is not None else None
+    console = Console(args.instance)
+    code = 0
+    tty = lines is None and sys.stdin.isatty()
+    try:
+        source = lines if lines is not None else sys.stdin
+        if tty:
+            print("hubo-console: type help for the commands", file=sys.stderr)
+        while True:
+            if tty:
+                print("hubo> ", end="", file=sys.stderr, flush=True)
+            line = next(iter(source), None) if lines is None else (
+                lines.pop(0) if lines else None)
+            if line is None:
+                break
+            try:
+                if not console.execute(line):
+                    break
+            except InputError as exc:
+                print(f"hubo-console: {exc}", file=sys.stderr)
+                code = max(code, 2)
+            except HuboLadderError as exc:
+                print(f"hubo-console: {exc}", file=sys.stderr)
+                code = 1 if code == 0 else code
+    except KeyboardInterrupt:
+        pass
+    finally:
+        console.close()
+    return code
+
+
+if __name__ == "__main__":
+    sys.exit(main())
