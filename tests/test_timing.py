@@ -161,3 +161,31 @@ def test_samples_breaking_a_limit_are_timed_again_then_refused(monkeypatch):
 def test_bad_rate_is_refused():
     with pytest.raises(ValueError, match="rate"):
         time_parameterize([], LIMITS, TimingConfig(rate_hz=0.0))
+
+
+def test_spline_overshoot_at_a_limit_is_bounded_smoothly():
+    # A knee driven onto its lower limit (0 rad) and held there: the spline rings past it.
+    k = JOINT_INDEX["RKN"]
+    lo = LIMITS.lower_rad[k]
+    n = 60
+    cols = np.zeros((n, 40))
+    cols[:, k] = np.maximum(lo, np.linspace(0.3, -0.3, n))
+    cols[:, JOINT_INDEX["RSP"]] = np.linspace(0.0, -0.6, n)  # keeps the path moving
+    timed = time_parameterize([SegmentPath("knee", cols)], LIMITS,
+                              TimingConfig(rate_hz=RATE_HZ))
+    q = timed.columns_rad
+    assert q[:, k].min() >= lo
+    acc = np.abs(np.diff(q, n=2, axis=0)) * RATE_HZ**2
+    assert np.all(acc <= LIMITS.accel_nominal_rad_s2 * (1 + 1e-6))
+    np.testing.assert_array_equal(q[[0, -1]], cols[[0, -1]])
+
+
+def test_limit_smoothing_is_a_convex_blend_with_exact_ends():
+    k = JOINT_INDEX["LHP"]
+    lines = np.zeros((200, 40))
+    lines[:, k] = LIMITS.lower_rad[k] + 0.01 * np.sin(np.linspace(0, 12, 200)) - 0.002
+    out = timing._limit_positions(lines, LIMITS)
+    assert out[:, k].min() >= LIMITS.lower_rad[k]
+    np.testing.assert_array_equal(out[[0, -1], k], np.clip(lines[[0, -1], k],
+                                                           LIMITS.lower_rad[k], None))
+    np.testing.assert_array_equal(np.delete(out, k, axis=1), np.delete(lines, k, axis=1))
