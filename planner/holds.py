@@ -19,18 +19,44 @@ def _pose(R: np.ndarray, p: np.ndarray) -> np.ndarray:
     return T
 
 
-def palm_rotation(geom: LadderGeometry, side: str) -> np.ndarray:
-    """R_world_palm of a hand closed on a rail.
+#: Ways to roll a closed hand about its rail (see `palm_rotation`).
+GRIP_STYLES = ("facing", "shoulder")
 
-    The grip axis (palm x) runs along the rail; the open side of the hand (s·y_palm, s = +1
-    left, −1 right) faces into the ladder so the hand can back off towards the climber;
-    the wrist (palm +z) is then inboard of the rail.
+
+def palm_rotation(geom: LadderGeometry, side: str, grip_m: np.ndarray | None = None,
+                  shoulder_m: np.ndarray | None = None, style: str = "facing") -> np.ndarray:
+    """R_world_palm of a hand closed on a rail at ``grip_m``. The grip axis (palm x) runs
+    along the rail; the roll about the rail depends on ``style``:
+
+    - ``facing``: the hand's open side (s·y_palm, s = +1 left, −1 right) faces into the
+      ladder and the wrist (palm +z) is inboard of the rail; the hand backs off towards the
+      climber. Suits rails well outboard of the shoulders.
+    - ``shoulder``: the wrist points back towards the shoulder at ``shoulder_m``, the way a
+      person grips a rail in front of them, and the open side faces outboard; the hand
+      backs off inboard. The forearm never crosses the chest, however close the rails.
     """
     s = 1.0 if side == "left" else -1.0
     d, n = geom.ladder_direction, geom.rung_line_normal
-    x = -d
-    y = -s * n
-    return np.column_stack([x, y, np.cross(x, y)])
+    if style == "facing":
+        x, y = -d, -s * n
+        return np.column_stack([x, y, np.cross(x, y)])
+    if style != "shoulder":
+        raise ValueError(f"unknown grip style {style!r}; use one of {GRIP_STYLES}")
+    v = np.asarray(shoulder_m, dtype=float) - np.asarray(grip_m, dtype=float)
+    z = v - (v @ d) * d
+    z /= np.linalg.norm(z)
+    outboard = s * geom.lateral_direction
+    for x in (-d, d):
+        y = np.cross(z, x)
+        if (s * y) @ outboard >= 0:
+            return np.column_stack([x, y, z])
+    raise AssertionError("unreachable: one of the two grip-axis signs is outboard")
+
+
+def hand_retreat_direction(hold: Hold) -> np.ndarray:
+    """Unit vector along which a hand leaves its rail: away from its open side."""
+    s = 1.0 if hold.limb == "left_hand" else -1.0
+    return -s * hold.T_world_frame[:3, 1]
 
 
 def rail_point(geom: LadderGeometry, side: str, rung: int, along_m: float = 0.0) -> np.ndarray:
@@ -52,8 +78,13 @@ def sole_contact_points(params: RobotParams, T_world_sole: np.ndarray,
 
 
 def make_hold(seed: HoldSeed, geom: LadderGeometry, params: RobotParams,
-              floor_pose: dict[str, np.ndarray] | None = None, offset_m=(0.0, 0.0)) -> Hold:
-    """A concrete hold for a seed, shifted by ``offset_m`` = (along, lateral) in L [m]."""
+              floor_pose: dict[str, np.ndarray] | None = None, offset_m=(0.0, 0.0),
+              shoulder_m: np.ndarray | None = None, grip_style: str = "facing") -> Hold:
+    """A concrete hold for a seed, shifted by ``offset_m`` = (along, lateral) in L [m].
+
+    A rail hold takes a ``grip_style`` (see `palm_rotation`); the ``shoulder`` style needs
+    ``shoulder_m``, the current position of that arm's shoulder [m].
+    """
     mu = geom.spec.friction
     up = np.array([0.0, 0.0, 1.0])
     hl = params.foot_length_m / 2
@@ -75,7 +106,7 @@ def make_hold(seed: HoldSeed, geom: LadderGeometry, params: RobotParams,
         return Hold(seed.limb, seed.target, T, pts, np.tile(up, (4, 1)), mu)
     if isinstance(seed, RailSeed):
         p = rail_point(geom, seed.side, seed.rung, seed.along_m + offset_m[0])
-        T = _pose(palm_rotation(geom, seed.side), p)
+        T = _pose(palm_rotation(geom, seed.side, p, shoulder_m, grip_style), p)
         # Thesis hand hold: a contact pushing up and one pulling the hand towards the ladder.
         towards_ladder = geom.R_world_ladder @ np.array([1.0, 0.0, 0.0])
         return Hold(seed.limb, seed.target, T, np.vstack([p, p]),

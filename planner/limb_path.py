@@ -12,6 +12,7 @@ import numpy as np
 
 from ladders.geometry import LadderGeometry
 from planner.contacts import Hold
+from planner.holds import hand_retreat_direction
 from primitives.primitive import LimbWaypoints
 from robot.params import RobotParams
 
@@ -28,16 +29,18 @@ def _shifted(T: np.ndarray, dp: np.ndarray) -> np.ndarray:
 
 def hand_waypoints(T_from: np.ndarray, target: Hold, geom: LadderGeometry,
                    recipe: LimbWaypoints, on_rail: bool) -> list[np.ndarray]:
-    """Palm poses from ``T_from`` to the new rail hold, backing off along the rail normal.
+    """Palm poses from ``T_from`` to the new rail hold, backing off away from the hand's
+    open side, travelling along the rail and approaching the new hold the same way.
 
     ``on_rail`` says whether the hand starts closed on a rail (it then backs off first).
     """
-    away = geom.rung_line_normal * recipe.clearance_m
+    away = hand_retreat_direction(target) * recipe.clearance_m
     T_to = target.T_world_frame
     T_pre = _shifted(T_to, away)
     points = [T_from]
     if on_rail:
-        points.append(_shifted(T_from, away))
+        s = 1.0 if target.limb == "left_hand" else -1.0
+        points.append(_shifted(T_from, -s * T_from[:3, 1] * recipe.clearance_m))
     else:
         # From the floor the hand rises inside the rail, then moves out to it: a straight
         # line from the hanging pose would sweep past the rail's lower end.
@@ -49,8 +52,8 @@ def hand_waypoints(T_from: np.ndarray, target: Hold, geom: LadderGeometry,
 
 def foot_waypoints(T_from: np.ndarray, target: Hold, geom: LadderGeometry,
                    params: RobotParams, recipe: LimbWaypoints, rung: int) -> list[np.ndarray]:
-    """Sole poses from ``T_from`` to a rung hold: lift, pull back, rise over the rung's
-    rear edge with clearance, move over the tread, set down."""
+    """Sole poses from ``T_from`` to a rung hold: lift, pull back until the toes are behind
+    the rung's rear edge, rise above it with clearance, move over the tread, set down."""
     spec = geom.spec
     to_L = geom.to_ladder
     p_from_L, p_to_L = to_L(T_from[:3, 3]), to_L(target.T_world_frame[:3, 3])
@@ -59,12 +62,14 @@ def foot_waypoints(T_from: np.ndarray, target: Hold, geom: LadderGeometry,
     # Toes (half a foot ahead of the sole centre) must stay behind the rear edge while rising.
     x_clear = min(p_from_L[0], rear_edge_x - params.foot_length_m / 2 - recipe.clearance_m / 2)
     lift_L = p_from_L + [0.0, 0.0, recipe.lift_m]
+    # Pull back at lift height first: on deep treads the toes start under the next rung.
+    back_L = np.array([x_clear, lift_L[1], lift_L[2]])
     rise_L = np.array([x_clear, p_from_L[1] + (p_to_L[1] - p_from_L[1]) / 2,
                        max(top_z, lift_L[2])])
     over_L = np.array([p_to_L[0], p_to_L[1], top_z])
     R = target.T_world_frame[:3, :3]
     poses = [T_from]
-    for p_L in (lift_L, rise_L, over_L):
+    for p_L in (lift_L, back_L, rise_L, over_L):
         T = np.eye(4)
         T[:3, :3], T[:3, 3] = R, geom.to_world(p_L)
         poses.append(T)

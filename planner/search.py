@@ -20,7 +20,7 @@ from ladders.spec import LadderSpec
 from planner.collision import CollisionModel
 from planner.contacts import Hold, Stance
 from planner.feasible import FeasibleSearchStats, SearchTarget, find_feasible
-from planner.holds import make_hold
+from planner.holds import GRIP_STYLES, make_hold
 from planner.ik import IKConfig, solve_ik
 from planner.interpolation import (
     InterpolationError,
@@ -40,7 +40,9 @@ from robot.kinematic_tree import FINGER_CLOSED_RAD
 log = logging.getLogger(__name__)
 
 #: Largest joint correction [rad] when a placed limb is snapped exactly onto its hold.
-POLISH_MAX_RAD = 0.05
+POLISH_MAX_RAD = 0.1
+#: Clearance between an inboard forearm's elbow end and the chest for the facing grip [m].
+FOREARM_CLEARANCE_M = 0.05
 #: Weight of the seed pelvis position in IK (soft, against hard holds).
 PELVIS_WEIGHT = 1.0
 #: Start posture [rad], per side (roll signs mirrored): knees a little bent (a straight
@@ -101,6 +103,17 @@ class SearchResult:
     total_s: float
 
 
+def preferred_grip_style(geom: LadderGeometry, params) -> str:
+    """``facing`` when a forearm lying inboard of the rail, level with it, ends clear of
+    the chest; ``shoulder`` otherwise (narrow rails, e.g. the ship ladder)."""
+    from robot.kinematic_tree import ROOT_LINK, build_tree
+
+    torso_half_width = max(g.half[1] for lk in build_tree(params).links
+                           if lk.name in ("torso", ROOT_LINK) for g in lk.geoms if g.kind == "box")
+    elbow_y = geom.spec.rail_spacing_m / 2 - params.wrist_to_palm_m - params.forearm_m
+    return "facing" if elbow_y >= torso_half_width + FOREARM_CLEARANCE_M else "shoulder"
+
+
 def _limb_side(limb: str) -> str:
     return "left" if limb.startswith("left") else "right"
 
@@ -122,6 +135,7 @@ class ClimbPlanner:
         self.rng = np.random.default_rng(seed)
         self.torso_R = self.geom.R_world_ladder.copy()
         self.away = -self.geom.R_world_ladder[:, 0]
+        self.preferred_grip = preferred_grip_style(self.geom, self.kin.params)
         self.ik_config = IKConfig()
         self.ik_waypoint_config = IKConfig(
             moving_tol_m=self.ik_config.waypoint_tol_m,
@@ -190,14 +204,23 @@ class ClimbPlanner:
             out.append(qi)
         return out
 
-    def _sample_hold(self, seed, radius_m: float) -> Hold:
+    def _sample_hold(self, seed, radius_m: float, q: np.ndarray, attempt: int) -> Hold:
+        """A hold near the seed: offsets within ``radius_m``; rail holds alternate the grip
+        style between attempts (ladder-facing first)."""
         if radius_m > 0:
             along = self.rng.uniform(-radius_m, radius_m)
             lateral = 0.0 if isinstance(seed, RailSeed) else self.rng.uniform(-radius_m,
                                                                               radius_m) / 2
         else:
             along = lateral = 0.0
-        return make_hold(seed, self.geom, self.kin.params, offset_m=(along, lateral))
+        shoulder = None
+        if isinstance(seed, RailSeed):
+            frame = ("L" if seed.limb == "left_hand" else "R") + "_shoulder_pitch"
+            shoulder = self.kin.frame_pose(q, frame)[:3, 3]
+        first = GRIP_STYLES.index(self.preferred_grip)
+        style = GRIP_STYLES[(first + attempt) % len(GRIP_STYLES)]
+        return make_hold(seed, self.geom, self.kin.params, offset_m=(along, lateral),
+                         shoulder_m=shoulder, grip_style=style)
 
     def _pelvis_target(self, step: Step, support) -> np.ndarray:
         """Seed pelvis position: the primitive's offset from the supporting feet."""
@@ -239,13 +262,15 @@ class ClimbPlanner:
 
     # ----------------------------------------------------------------------------------
     def try_step(self, step: Step, q: np.ndarray, stance: Stance, radius_m: float,
-                 stats: StepStats) -> tuple[list[PathSegment], np.ndarray, Stance]:
+                 stats: StepStats, attempt: int = 0
+                 ) -> tuple[list[PathSegment], np.ndarray, Stance]:
         """One sample of a step; raises `InterpolationError`/`_StepRejected` on failure."""
         prim = step.primitive
         moving_limbs = prim.moving_limbs
         support = tuple(h for h in stance.holds if h.limb not in moving_limbs)
         support_stance = Stance(support)
-        new_holds = tuple(self._sample_hold(seed, radius_m) for seed in step.new_holds)
+        new_holds = tuple(self._sample_hold(seed, radius_m, q, attempt)
+                          for seed in step.new_holds)
         next_stance = Stance(support + new_holds)
         fstats = FeasibleSearchStats()
         segments: list[PathSegment] = []
@@ -381,7 +406,8 @@ class ClimbPlanner:
             if time.perf_counter() - t_start > self.config.time_limit_s:
                 raise PlanningFailed(step, f"time limit of {self.config.time_limit_s:g} s reached")
             try:
-                segs, q_new, stance_new = self.try_step(step, q, stance, radius, stats[i])
+                segs, q_new, stance_new = self.try_step(step, q, stance, radius, stats[i],
+                                                        failures[i])
             except (_StepRejected, InterpolationError) as exc:
                 failures[i] += 1
                 stats[i].seconds += time.perf_counter() - t0
@@ -391,9 +417,13 @@ class ClimbPlanner:
                 if failures[i] >= self.config.samples_per_step:
                     if i == 0 or backtracks >= self.config.max_backtracks:
                         raise PlanningFailed(step, f"{failures[i]} samples failed; last: {exc}") from None
+                    # A dead end counts as a failure of the step before, and a step that is
+                    # backtracked into gets half its budget next time, so repeated dead
+                    # ends reach further back instead of cycling between two steps.
                     backtracks += 1
                     stats[i - 1].backtracks += 1
-                    failures[i] = 0
+                    failures[i] = self.config.samples_per_step // 2
+                    failures[i - 1] += self.config.samples_per_step // 5
                     states.pop()
                     i -= 1
                 continue

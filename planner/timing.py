@@ -43,6 +43,12 @@ log = logging.getLogger(__name__)
 #: accelerations then exceeded the limit by 14 %. The ends are at rest anyway, because
 #: toppra starts and stops with zero path speed.
 BC_TYPE = "not-a-knot"
+#: A path turning by more than this at a point stops there: timed rest to rest [deg].
+CORNER_DEG = 30.0
+#: Width of the moving average that rounds off a dense IK path's kinks [points].
+PATH_SMOOTH_POINTS = 9
+#: Spacing of the spline's knots along a dense path [rad of joint-space path].
+KNOT_SPACING_RAD = 0.05
 #: Width of the moving average that smooths a joint where it was clipped [samples].
 SMOOTH_SAMPLES = 15
 #: Limit scale factor applied on each retry.
@@ -170,6 +176,49 @@ def _toppra_trajectory(s: np.ndarray, columns: np.ndarray, v_max: np.ndarray,
     return inst.compute_trajectory(0, 0)
 
 
+class _TrapezoidTrajectory:
+    """Rest-to-rest trapezoidal timing along a spline q(s): the fallback when toppra's LP
+    solver finds a path numerically uncontrollable.
+
+    Path speed ṡ ≤ V and |s̈| ≤ A are uniform bounds chosen so that every joint meets
+    |q'·ṡ| ≤ v and |q'·s̈ + q''·ṡ²| ≤ a everywhere on a fine grid: half of each joint's
+    acceleration budget goes to the path's curvature at speed V, half to speeding up.
+    Slower than time-optimal, which a quasi-static climb does not need; always feasible.
+    """
+
+    def __init__(self, s: np.ndarray, way: np.ndarray, v_max: np.ndarray, a_max: np.ndarray):
+        from scipy.interpolate import CubicSpline
+
+        self.spline = CubicSpline(s, way, bc_type=BC_TYPE, axis=0)
+        grid = np.linspace(s[0], s[-1], max(200, 20 * len(s)))
+        d1 = np.abs(self.spline(grid, 1)).max(axis=0)
+        d2 = np.abs(self.spline(grid, 2)).max(axis=0)
+        with np.errstate(divide="ignore"):
+            v_path = np.min(np.where(d1 > 1e-12, v_max / d1, np.inf))
+            v_curv = np.min(np.where(d2 > 1e-12, np.sqrt(0.5 * a_max / d2), np.inf))
+            a_path = np.min(np.where(d1 > 1e-12, 0.5 * a_max / d1, np.inf))
+        self.V, self.A = float(min(v_path, v_curv)), float(a_path)
+        self.length = float(s[-1] - s[0])
+        self.s0 = float(s[0])
+        t_ramp = self.V / self.A
+        if self.A * t_ramp**2 >= self.length:  # triangular profile: never reaches V
+            t_ramp = math.sqrt(self.length / self.A)
+            self.V = self.A * t_ramp
+        self.t_ramp = t_ramp
+        self.duration = 2 * t_ramp + (self.length - self.A * t_ramp**2) / self.V
+
+    def _eval_params(self, ts: np.ndarray):
+        ts = np.asarray(ts, dtype=float)
+        tr, A, V, T = self.t_ramp, self.A, self.V, self.duration
+        s = np.where(ts < tr, 0.5 * A * ts**2,
+                     np.where(ts > T - tr, self.length - 0.5 * A * (T - ts) ** 2,
+                              0.5 * A * tr**2 + V * (ts - tr)))
+        return self.s0 + np.clip(s, 0.0, self.length), None, None
+
+    def __call__(self, ts: np.ndarray) -> np.ndarray:
+        return self.spline(self._eval_params(ts)[0])
+
+
 def _path_parameter(columns: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Cumulative joint-space distance ``s`` [rad] and the indices of the points kept
     (points that do not move from their predecessor are dropped: ``s`` must increase)."""
@@ -214,6 +263,29 @@ def _box(x: np.ndarray, width: int) -> np.ndarray:
     return (c[width:] - c[:-width]) / width
 
 
+def _fade_weight(n: int, ramp: int) -> np.ndarray:
+    """0 at both ends of n samples, 1 inside, a smoothstep over ``ramp`` samples."""
+    u = np.clip(np.minimum(np.arange(n), np.arange(n)[::-1]) / max(ramp, 1), 0.0, 1.0)
+    return u * u * (3.0 - 2.0 * u)
+
+
+def _smooth_path(way: np.ndarray, width: int) -> np.ndarray:
+    """The dense IK path with its kinks rounded off before time parameterisation.
+
+    Points projected one by one by IK can change direction abruptly; a spline through them
+    turns that into curvature spikes between toppra's grid points, and the sampled file
+    then broke the acceleration limit by half. A triangular moving average (``width``
+    points, 0.01 rad apart, twice) rounds them off. The ends stay exact (stance changes
+    join bit for bit). Joints move by a few mrad: far inside the 1 cm hold tolerance that
+    ``check-plan`` verifies on the written file.
+    """
+    if width < 2 or len(way) < 3:
+        return way
+    weight = _fade_weight(len(way), width)[:, None]
+    smooth = np.column_stack([_box(_box(way[:, j], width), width) for j in range(way.shape[1])])
+    return way + weight * (smooth - way)
+
+
 def _limit_positions(lines: np.ndarray, limits: JointLimits) -> np.ndarray:
     """Samples within the joint position limits.
 
@@ -234,10 +306,7 @@ def _limit_positions(lines: np.ndarray, limits: JointLimits) -> np.ndarray:
     if not hit.any() or len(lines) < 3:
         return clipped
     # Blend weight: 0 at both ends (exact, at rest), 1 inside, a smoothstep in between.
-    n = len(lines)
-    ramp = 3 * SMOOTH_SAMPLES
-    u = np.clip(np.minimum(np.arange(n), np.arange(n)[::-1]) / ramp, 0.0, 1.0)
-    weight = u * u * (3.0 - 2.0 * u)
+    weight = _fade_weight(len(lines), 3 * SMOOTH_SAMPLES)
     out = clipped.copy()
     for j in np.flatnonzero(hit):
         smooth = _box(_box(clipped[:, j], SMOOTH_SAMPLES), SMOOTH_SAMPLES)
@@ -256,15 +325,34 @@ def _time_segment(seg: SegmentPath, limits: JointLimits, cfg: TimingConfig
     s_all, kept = _path_parameter(cols)
     if len(s_all) < 2 or s_all[-1] < cfg.min_motion_rad:
         return None
-    way = cols[kept]
+    way = _smooth_path(cols[kept], PATH_SMOOTH_POINTS)
     scale, sub = cfg.limit_scale, cfg.grid_subdivision
     for attempt in range(cfg.retries + 1):
-        traj = _toppra_trajectory(s_all, way, scale * limits.velocity_nominal_rad_s,
-                                  scale * limits.accel_nominal_rad_s2, sub)
+        traj = None
+        # The spline runs through knots about KNOT_SPACING_RAD of path apart, not through
+        # every dense IK point (0.01 rad apart): through all of them toppra's LP solver
+        # found the path numerically uncontrollable at times. Between corners the dense
+        # path is smooth, so the spline strays from the dropped points by little; a
+        # coarser or finer grid is tried when toppra still fails.
+        for spacing in KNOT_SPACING_RAD * np.array([1.0, 0.8, 2.0, 0.6, 1.4, 4.0, 0.4]):
+            n_knots = int(min(len(way), max(4, math.ceil(s_all[-1] / spacing) + 1)))
+            idx = np.unique(np.round(np.linspace(0, len(way) - 1, n_knots)).astype(int))
+            for grid_sub in (sub, 1, 3):
+                traj = _toppra_trajectory(s_all[idx], way[idx],
+                                          scale * limits.velocity_nominal_rad_s,
+                                          scale * limits.accel_nominal_rad_s2, grid_sub)
+                if traj is not None:
+                    break
+            if traj is not None:
+                break
         if traj is None:
-            raise TimingError(f"segment {seg.label}: toppra found no time parameterisation "
-                              f"of its {len(way)}-point path ({s_all[-1]:.3f} rad long) "
-                              f"within the velocity and acceleration limits ×{scale:.3g}")
+            log.info("%s: toppra found no parameterisation; timing it with a conservative "
+                     "trapezoid", seg.label)
+            n_knots = int(min(len(way), max(4, math.ceil(s_all[-1] / KNOT_SPACING_RAD) + 1)))
+            idx = np.unique(np.round(np.linspace(0, len(way) - 1, n_knots)).astype(int))
+            traj = _TrapezoidTrajectory(s_all[idx], way[idx],
+                                        scale * limits.velocity_nominal_rad_s,
+                                        scale * limits.accel_nominal_rad_s2)
         duration = float(traj.duration)
         n = max(1, math.ceil(duration * cfg.rate_hz - 1e-9))
         # n equal steps of duration / n ≤ 1 / rate: played at the file rate, the motion
@@ -287,6 +375,52 @@ def _time_segment(seg: SegmentPath, limits: JointLimits, cfg: TimingConfig
     if seg.configs is not None:
         configs = _interpolate_configs(s_all, np.asarray(seg.configs, dtype=float)[kept], s_t)
     return lines, configs, duration
+
+
+def _corner_indices(cols: np.ndarray) -> list[int]:
+    """Points where the path turns by more than `CORNER_DEG` (way-point junctions, where
+    the moving limb changes direction, and the snap onto a hold)."""
+    d = np.diff(cols, axis=0)
+    norm = np.linalg.norm(d, axis=1)
+    moving = np.flatnonzero(norm > 1e-12)
+    corners = []
+    for a, b in zip(moving[:-1], moving[1:], strict=True):
+        cos = float(d[a] @ d[b] / (norm[a] * norm[b]))
+        if cos < math.cos(math.radians(CORNER_DEG)):
+            corners.append(int(b))  # the point between step a and step b
+    return corners
+
+
+def _time_segment_at_corners(seg: SegmentPath, limits: JointLimits, cfg: TimingConfig
+                             ) -> tuple[np.ndarray, np.ndarray | None, float] | None:
+    """Time a segment piece by piece between its corners, each piece rest to rest.
+
+    A quasi-static climber stops where its path turns sharply; a spline through such a
+    corner must overshoot it, and the sampled file then broke the acceleration limit.
+    """
+    cols = np.asarray(seg.columns_rad, dtype=float)
+    cuts = [0] + _corner_indices(cols) + [len(cols) - 1]
+    if len(cuts) == 2:
+        return _time_segment(seg, limits, cfg)
+    lines, confs, total = [], [], 0.0
+    for k, (a, b) in enumerate(zip(cuts[:-1], cuts[1:], strict=True)):
+        piece = SegmentPath(f"{seg.label}#{k}", cols[a:b + 1],
+                            None if seg.configs is None else
+                            np.asarray(seg.configs, dtype=float)[a:b + 1], False)
+        timed = _time_segment(piece, limits, cfg)
+        if timed is None:
+            continue
+        p_lines, p_confs, duration = timed
+        if lines:  # the shared corner is already the last line
+            p_lines = p_lines[1:]
+            p_confs = None if p_confs is None else p_confs[1:]
+        lines.append(p_lines)
+        confs.append(p_confs)
+        total += duration
+    if not lines:
+        return None
+    configs = None if seg.configs is None else np.vstack(confs)
+    return np.vstack(lines), configs, total
 
 
 def time_parameterize(segments: Sequence[SegmentPath], limits: JointLimits,
@@ -327,7 +461,7 @@ def time_parameterize(segments: Sequence[SegmentPath], limits: JointLimits,
     skipped: list[int] = []
     have_configs = all(s.configs is not None for s in segments)
     for i, seg in enumerate(segments):
-        timed = _time_segment(seg, limits, cfg)
+        timed = _time_segment_at_corners(seg, limits, cfg)
         if timed is None:
             skipped.append(i)
             log.debug("segment %s does not move: skipped", seg.label)

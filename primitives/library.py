@@ -11,10 +11,12 @@ from __future__ import annotations
 from primitives.hold_seeds import MOUNT_ALONG_RAIL_M, foot_on_rung, hand_on_rail
 from primitives.primitive import LimbWaypoints, Primitive, Step
 
-# Seed postures [rad]: arms reaching forward and out to the rails with bent elbows; legs
+# Seed postures [rad]: arms reaching forward and out to the rails with bent elbows and
+# straight wrists (a flexed wrist folds the open fingers onto the forearm); legs
 # a little bent (a straight knee is a kinematic singularity). Fingers are set by the
 # planner. Foot moves leave the legs to the pelvis target (over the stance foot).
-_ARMS = {"LSP": -0.6, "RSP": -0.6, "LSR": 0.5, "RSR": -0.5, "LEB": -1.0, "REB": -1.0}
+_ARMS = {"LSP": -0.6, "RSP": -0.6, "LSR": 0.5, "RSR": -0.5, "LEB": -1.0, "REB": -1.0,
+         "LWP": 0.0, "RWP": 0.0}
 _STAND = {"LHP": -0.35, "RHP": -0.35, "LKN": 0.6, "RKN": 0.6, "LAP": -0.25, "RAP": -0.25}
 
 #: Hands stand off 10 cm from the rail before closing in: palm plate (2 cm) and open

@@ -16,8 +16,8 @@ from primitives.hold_seeds import HoldSeed
 class LimbWaypoints:
     """How a moving limb travels from its old hold to its new one.
 
-    Hands: open the fingers, back off the rail by ``clearance_m`` along the rail normal
-    (towards the climber), travel parallel to the rail, approach, close the fingers.
+    Hands: open the fingers, back off the rail by ``clearance_m`` away from the hand's
+    open side, travel parallel to the rail, approach, close the fingers.
     Feet: lift ``lift_m``, pull back until the toes clear the target rung's edge by
     ``clearance_m`` while rising ``clearance_m`` above its top, move over it, set down.
     """
