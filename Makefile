@@ -14,8 +14,15 @@ $(STAMP): pyproject.toml
 	$(BIN)/python -m pip install --quiet -e ".[test,dask]"
 	touch $(STAMP)
 
+# The main job on the bundled DRC ladder: plan the climb, verify it kinematically, then
+# play it in MuJoCo through the robot's own control code (mixed position/PWM arms).
 demo: install
-	$(BIN)/python -m execute.demo drc --out demo-out
+	mkdir -p demo-out
+	$(BIN)/python -m ladders show drc --out demo-out
+	$(BIN)/plan-ladder drc --seed 1 -o demo-out/drc.traj --plots demo-out/stances
+	$(BIN)/check-plan demo-out/drc.traj --ladder drc --every 10
+	MUJOCO_GL=egl $(BIN)/validate-plan demo-out/drc.traj --strategy mixed \
+		--json demo-out/drc.result.json --plots demo-out/plots
 
 test: install
 	MUJOCO_GL=egl $(BIN)/python -m pytest -q

@@ -15,9 +15,8 @@ from typing import Literal
 
 import numpy as np
 
-from robot.errors import InputError
-
 from ladders.spec import STRINGER_DEPTH_M, STRINGER_WIDTH_M, LadderSpec
+from robot.errors import InputError
 
 SIDES: tuple[str, str] = ("left", "right")
 _SIDE_SIGN = {"left": 1.0, "right": -1.0}  # left = +y_L
@@ -234,7 +233,8 @@ class LadderGeometry:
         """
         self._check_rung(i)
         p0, _ = self.rail_axis(side)
-        return p0 + self.spec.rung_height_m(i) / math.sin(self.spec.slope_rad) * self.ladder_direction
+        along_m = self.spec.rung_height_m(i) / math.sin(self.spec.slope_rad)
+        return p0 + along_m * self.ladder_direction
 
     def closest_rail_point(self, side: str, p_world: np.ndarray) -> np.ndarray:
         """The point of a rail's axis segment closest to a world point [m].

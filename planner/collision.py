@@ -1,10 +1,10 @@
 """Collision checking with coal on the robot's primitive geometry and the ladder.
 
 The robot's capsules and boxes come from the kinematic tree (the same primitives the
-MuJoCo model uses). Self pairs are every pair of links at least two joints apart (with
-co-located joints merged) that do not already touch in the zero pose (the SRDF rule). Environment pairs are every
-robot geometry against the floor and each ladder part; a limb's end links are allowed to
-touch what that limb holds.
+MuJoCo model uses). Self pairs are every pair of solid bodies not adjacent in the tree
+(motor links without geometry do not count) that do not already touch in the zero pose
+(the SRDF rule). Environment pairs are every robot geometry against the floor and each
+ladder part; a limb's end links are allowed to touch what that limb holds.
 """
 
 from __future__ import annotations

@@ -108,7 +108,7 @@ def _descend_torque(kin: HuboKinematics, checker: FeasibilityChecker, q_seed: np
 def find_feasible(kin: HuboKinematics, checker: FeasibilityChecker, q_seed: np.ndarray,
                   target: SearchTarget, rng: np.random.Generator, *, attempts: int = 10,
                   posture_perturb_rad: float = 0.3, pelvis_perturb_m: float = 0.08,
-                  retract_step_m: float = 0.04, ik_config: IKConfig = IKConfig(),
+                  retract_step_m: float = 0.04, ik_config: IKConfig | None = None,
                   stats: FeasibleSearchStats | None = None
                   ) -> tuple[np.ndarray | None, Verdict | None]:
     """A feasible configuration near ``q_seed`` for ``target``, or (None, last verdict).
@@ -117,6 +117,7 @@ def find_feasible(kin: HuboKinematics, checker: FeasibilityChecker, q_seed: np.n
     maxima on the last one.
     """
     stats = stats or FeasibleSearchStats()
+    ik_config = ik_config or IKConfig()
     region = checker.region(target.stability_stance)
     polygon = None if region.is_empty else region.clockwise_vertices()
     last: Verdict | None = None

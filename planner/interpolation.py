@@ -57,7 +57,7 @@ def contact_space_interpolate(kin: HuboKinematics, checker: FeasibilityChecker,
                               qa: np.ndarray, qb: np.ndarray, support: tuple[Hold, ...],
                               stability_stance: Stance, contacts: dict[str, str], *,
                               moving: tuple[Hold, ...] = (), resolution_rad: float = 0.01,
-                              max_depth: int = 14, ik_config: IKConfig = IKConfig(),
+                              max_depth: int = 14, ik_config: IKConfig | None = None,
                               stats: InterpolationStats | None = None) -> list[np.ndarray]:
     """Configurations from ``qa`` (excluded) to ``qb`` (included), each within
     ``resolution_rad`` of the next in every joint, all on the contact constraints.
@@ -70,6 +70,7 @@ def contact_space_interpolate(kin: HuboKinematics, checker: FeasibilityChecker,
         InterpolationError: a midpoint did not project or is infeasible.
     """
     stats = stats if stats is not None else InterpolationStats()
+    ik_config = ik_config or IKConfig()
 
     def rec(q0: np.ndarray, q1: np.ndarray, depth: int) -> list[np.ndarray]:
         if kin.joint_distance(q0, q1) <= resolution_rad:

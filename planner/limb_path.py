@@ -16,7 +16,6 @@ from planner.holds import hand_retreat_direction
 from primitives.primitive import LimbWaypoints
 from robot.params import RobotParams
 
-
 #: The first grasp approaches from this far inboard of the rail [m].
 INBOARD_APPROACH_M = 0.15
 

@@ -282,7 +282,7 @@ class ClimbPlanner:
             q_new, verdict = find_feasible(self.kin, self.checker, q, target, self.rng,
                                            attempts=self.config.feasible_attempts, stats=fstats)
             if q_new is None:
-                raise _StepRejected(f"no straightened pose: {verdict.reason if verdict is not None else '?'}")
+                raise _StepRejected(f"no straightened pose: {_why(verdict)}")
             path = self._interp(q, q_new, stance.holds, stance, self._contacts(stance.holds),
                                 stats)
             segments.append(PathSegment(step, "body", stance.holds, (), path))
@@ -301,7 +301,7 @@ class ClimbPlanner:
                                             attempts=self.config.feasible_attempts,
                                             stats=fstats)
             if q_lift is None:
-                raise _StepRejected(f"no lift-off pose: {verdict.reason if verdict is not None else '?'}")
+                raise _StepRejected(f"no lift-off pose: {_why(verdict)}")
             path = self._interp(q, q_lift, stance.holds, stance, contacts_all, stats)
             segments.append(PathSegment(step, "body", stance.holds, (), path))
 
@@ -347,8 +347,7 @@ class ClimbPlanner:
                 attempts=self.config.feasible_attempts, stats=fstats,
                 ik_config=self.ik_config if final else self.ik_waypoint_config)
             if q_next is None:
-                raise _StepRejected(f"way-point {i}/{n_way - 1}: "
-                                    f"{verdict.reason if verdict is not None else '?'}")
+                raise _StepRejected(f"way-point {i}/{n_way - 1}: {_why(verdict)}")
             limb_path += self._interp(q_cur, q_next, support, support_stance, contacts,
                                       stats, moving=targets)
             q_cur = q_next
@@ -388,7 +387,8 @@ class ClimbPlanner:
         t_start = time.perf_counter()
         top = self.top_rung() if top_rung is None else top_rung
         if not 0 <= top < self.spec.num_rungs:
-            raise HuboLadderError(f"top rung {top} is not on the ladder (0..{self.spec.num_rungs - 1})")
+            raise HuboLadderError(f"top rung {top} is not on the ladder "
+                                  f"(0..{self.spec.num_rungs - 1})")
         steps = climb_sequence(top)
         q0, stance0 = self.start_configuration()
         # Stack of (segments, q, stance) after each completed step.
@@ -416,7 +416,8 @@ class ClimbPlanner:
                 log.debug("%s sample %d failed: %s", step.label, failures[i], exc)
                 if failures[i] >= self.config.samples_per_step:
                     if i == 0 or backtracks >= self.config.max_backtracks:
-                        raise PlanningFailed(step, f"{failures[i]} samples failed; last: {exc}") from None
+                        raise PlanningFailed(
+                            step, f"{failures[i]} samples failed; last: {exc}") from None
                     # A dead end counts as a failure of the step before, and a step that is
                     # backtracked into gets half its budget next time, so repeated dead
                     # ends reach further back instead of cycling between two steps.
@@ -434,6 +435,10 @@ class ClimbPlanner:
             i += 1
         segments = [seg for segs, _, _ in states for seg in segs]
         return SearchResult(segments, states[-1][2], stats, time.perf_counter() - t_start)
+
+
+def _why(verdict) -> str:
+    return verdict.reason if verdict is not None else "no candidate converged"
 
 
 class _StepRejected(Exception):
