@@ -368,11 +368,15 @@ class ClimbPlanner:
         if not verdict.ok:
             raise _StepRejected(f"placed pose unstable in the new stance: {verdict.reason}")
 
-        # 5. Close the hands that arrived on a rail.
+        # 5. Close the hands that arrived on a rail. A closing hand is not a hold yet: it
+        # joins the holds in contact once its fingers are closed.
+        in_contact = list(support) + [h for h in new_holds if not h.is_hand]
         for hold in new_holds:
             if hold.is_hand:
                 path = self._finger_path(q_cur, _limb_side(hold.limb), FINGER_CLOSED_RAD)
-                segments.append(PathSegment(step, "grasp", next_stance.holds, (), path))
+                segments.append(PathSegment(step, "grasp", tuple(in_contact), (hold.limb,),
+                                            path))
+                in_contact.append(hold)
                 q_cur = path[-1]
         stats.samples += fstats.attempts
         for k, v in (fstats.rejections or {}).items():
