@@ -1,0 +1,125 @@
+"""The planner's search: IK projection, contact-space interpolation, determinism, failures."""
+
+import numpy as np
+import pytest
+
+from ladders.loader import load_ladder
+from planner.contacts import Stance
+from planner.ik import solve_ik
+from planner.interpolation import InterpolationError, contact_space_interpolate
+from planner.search import ClimbPlanner, PlannerConfig, PlanningFailed, StepStats
+from primitives.library import climb_sequence
+
+
+@pytest.fixture(scope="module")
+def planner():
+    return ClimbPlanner(load_ladder("drc"), seed=1)
+
+
+@pytest.fixture(scope="module")
+def standing(planner):
+    return planner.start_configuration()
+
+
+def _crouch(planner, q, stance, depth_m):
+    """A configuration with the pelvis lowered by ``depth_m``, feet kept on the floor."""
+    target = q[:3] - [0.0, 0.0, depth_m]
+    r = solve_ik(planner.kin, q, stance.holds, torso_R=planner.torso_R, pelvis_target_m=target,
+                 pelvis_weight=1.0)
+    assert r.converged
+    return r.q
+
+
+def test_start_configuration_stands_on_the_floor(planner, standing):
+    q, stance = standing
+    for hold in stance.holds:
+        T = planner.kin.frame_pose(q, hold.frame)
+        np.testing.assert_allclose(T, hold.T_world_frame, atol=1e-4)
+    verdict = planner.checker.check(q, stance, {h.limb: h.target for h in stance.holds})
+    assert verdict.ok and verdict.com_margin_m > 0.02
+
+
+def test_projection_keeps_contact_frames_on_their_holds(planner, standing):
+    q, stance = standing
+    qb = _crouch(planner, q, stance, 0.12)
+    path = contact_space_interpolate(planner.kin, planner.checker, q, qb, stance.holds, stance,
+                                     {h.limb: h.target for h in stance.holds})
+    assert len(path) > 5
+    for qi in path:
+        for hold in stance.holds:
+            p = planner.kin.frame_pose(qi, hold.frame)[:3, 3]
+            assert np.linalg.norm(p - hold.T_world_frame[:3, 3]) < 2e-4
+    # The plain joint-space midpoint would not keep them: the projection is doing work.
+    mid = planner.kin.interpolate(q, qb, 0.5)
+    drift = max(np.linalg.norm(planner.kin.frame_pose(mid, h.frame)[:3, 3]
+                               - h.T_world_frame[:3, 3]) for h in stance.holds)
+    assert drift > 1e-3
+
+
+@pytest.mark.parametrize("resolution", [0.01, 0.04])
+def test_interpolation_meets_the_resolution(planner, standing, resolution):
+    q, stance = standing
+    qb = _crouch(planner, q, stance, 0.12)
+    contacts = {h.limb: h.target for h in stance.holds}
+    path = contact_space_interpolate(planner.kin, planner.checker, q, qb, stance.holds, stance,
+                                     contacts, resolution_rad=resolution)
+    steps = [planner.kin.joint_distance(a, b) for a, b in zip([q] + path[:-1], path,
+                                                               strict=True)]
+    assert max(steps) <= resolution
+    assert np.array_equal(path[-1], qb)
+    coarse = contact_space_interpolate(planner.kin, planner.checker, q, qb, stance.holds,
+                                       stance, contacts, resolution_rad=4 * resolution)
+    assert len(coarse) < len(path)
+
+
+def test_recursion_depth_is_bounded(planner, standing):
+    q, stance = standing
+    qb = _crouch(planner, q, stance, 0.12)
+    with pytest.raises(InterpolationError, match="resolution not reached"):
+        contact_space_interpolate(planner.kin, planner.checker, q, qb, stance.holds, stance,
+                                  {h.limb: h.target for h in stance.holds}, max_depth=2)
+
+
+def test_interpolation_refuses_an_unstable_midpoint(planner, standing):
+    q, stance = standing
+    qb = _crouch(planner, q, stance, 0.05)
+    one_foot = Stance(stance.holds[:1])  # stability judged on one foot: the CoM is outside
+    with pytest.raises(InterpolationError, match="outside the support region|torque"):
+        contact_space_interpolate(planner.kin, planner.checker, q, qb, stance.holds, one_foot,
+                                  {h.limb: h.target for h in stance.holds})
+
+
+def test_first_step_is_deterministic_for_a_seed():
+    results = []
+    for _ in range(2):
+        p = ClimbPlanner(load_ladder("drc"), seed=7)
+        q, stance = p.start_configuration()
+        segs, q_end, _ = p.try_step(climb_sequence(0)[0], q, stance, 0.02, StepStats("x"))
+        results.append(np.vstack([c for s in segs for c in s.configs]))
+    assert np.array_equal(results[0], results[1])
+
+
+def test_placed_hands_meet_their_rail_holds(planner, standing):
+    q, stance = standing
+    segs, q_end, new_stance = planner.try_step(climb_sequence(0)[0], q, stance, 0.0,
+                                               StepStats("x"))
+    assert {h.limb for h in new_stance.holds} == {"left_foot", "right_foot", "left_hand",
+                                                  "right_hand"}
+    for hold in new_stance.holds:
+        p = planner.kin.frame_pose(q_end, hold.frame)[:3, 3]
+        assert np.linalg.norm(p - hold.T_world_frame[:3, 3]) < 1e-3
+        if hold.is_hand:  # on the rail's axis
+            axis_point = planner.geom.closest_rail_point(hold.target.split("_")[1], p)
+            assert np.linalg.norm(axis_point - p) < 1e-3
+    assert [s.phase for s in segs][-2:] == ["grasp", "grasp"]
+
+
+def test_unreachable_ladder_fails_with_the_primitive_and_rung():
+    from dataclasses import replace
+
+    far = replace(load_ladder("drc"), placement_x_m=1.5)  # rails out of the arms' reach
+    p = ClimbPlanner(far, config=PlannerConfig(samples_per_step=3, time_limit_s=60), seed=1)
+    with pytest.raises(PlanningFailed) as err:
+        p.plan(top_rung=0)
+    assert err.value.step.primitive.name == "placeHands"
+    assert "rung 0" in str(err.value)

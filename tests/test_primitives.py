@@ -1,0 +1,66 @@
+"""Primitives as data: the climbing sequence and seed holds that adapt to any ladder."""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from ladders.geometry import LadderGeometry
+from ladders.loader import load_ladder
+from planner.holds import make_hold, palm_rotation
+from primitives import RailSeed, RungSeed, climb_sequence
+from robot.params import DRC_HUBO
+
+
+def test_sequence_mounts_then_repeats_the_thesis_cycle():
+    steps = climb_sequence(2)
+    names = [s.primitive.name for s in steps]
+    assert names[:4] == ["placeHands", "placeLFoot", "placeRFoot", "straighten"]
+    cycle = ["moveLHand", "moveRHand", "moveLFoot", "moveRFoot", "straighten"]
+    assert names[4:] == cycle * 2
+    feet = [s.new_holds[0].rung for s in steps if isinstance(s.new_holds[:1] and
+                                                             s.new_holds[0], RungSeed)]
+    assert feet == [0, 0, 1, 1, 2, 2]
+    with pytest.raises(ValueError):
+        climb_sequence(-1)
+
+
+@pytest.mark.parametrize("name", ["drc", "ship", "stair"])
+def test_foot_holds_rest_on_their_rung(name):
+    spec = load_ladder(name)
+    geom = LadderGeometry(spec)
+    for rung in (0, spec.num_rungs - 1):
+        hold = make_hold(RungSeed("left_foot", rung, 0.11), geom, DRC_HUBO)
+        top = geom.rung_top_point(rung, lateral_m=0.11)
+        np.testing.assert_allclose(hold.T_world_frame[:3, 3], top, atol=1e-12)
+        assert np.all(hold.normals[:, 2] == 1.0) and hold.friction == spec.friction
+        # Contact corners lie on the tread, not beyond it.
+        along = geom.to_ladder(hold.points_m)[:, 0] - spec.rung_run_m(rung)
+        assert np.all(np.abs(along) <= spec.rung_depth_m / 2 + 1e-9)
+
+
+def test_rail_holds_follow_the_ladder_placement():
+    spec = load_ladder("drc")
+    moved = replace(spec, placement_x_m=spec.placement_x_m + 0.1, placement_yaw_rad=0.1)
+    for s in (spec, moved):
+        geom = LadderGeometry(s)
+        hold = make_hold(RailSeed("right_hand", "right", 3), geom, DRC_HUBO)
+        p = hold.T_world_frame[:3, 3]
+        assert np.linalg.norm(geom.closest_rail_point("right", p) - p) < 1e-9
+        # The grip axis runs along the rail.
+        assert abs(abs(hold.T_world_frame[:3, 0] @ geom.ladder_direction) - 1) < 1e-9
+
+
+def test_grip_styles_keep_the_grip_axis_on_the_rail():
+    geom = LadderGeometry(load_ladder("ship"))
+    grip = geom.rail_point_above_rung("left", 2)
+    shoulder = grip + np.array([-0.4, -0.15, -0.1])
+    for style in ("facing", "shoulder"):
+        R = palm_rotation(geom, "left", grip, shoulder, style)
+        np.testing.assert_allclose(R.T @ R, np.eye(3), atol=1e-12)
+        assert abs(abs(R[:, 0] @ geom.ladder_direction) - 1) < 1e-12
+    R = palm_rotation(geom, "left", grip, shoulder, "shoulder")
+    to_shoulder = shoulder - grip
+    assert R[:, 2] @ to_shoulder > 0  # the wrist points back towards the shoulder
+    with pytest.raises(ValueError):
+        palm_rotation(geom, "left", grip, shoulder, "sideways")
