@@ -1,0 +1,318 @@
+"""Sweep files: ladders spanning a parameter grid or sampled at random around a base.
+
+A sweep file (YAML) names a base ladder and the `LadderSpec` fields to vary::
+
+    base: drc                  # bundled ladder, or a spec file (relative to this file)
+    mode: grid                 # grid (every combination) or random
+    samples: 20                # random only: how many ladders
+    seed: 1                    # random only: the sampling seed (default 0)
+    parameters:
+      slope_deg: [55, 60, 65]                            # values (random: picked uniformly)
+      rung_spacing_m: {min: 0.25, max: 0.35, steps: 3}   # grid: linspace; random: U(min, max)
+      rail_spacing_m: {min: 1.1, max: 1.4, steps: 2}
+      rail_height_m: [0.8, 0.91]
+      rung_shape: [box, cylinder]
+
+Sweepable fields: every geometry, rail and contact field of a ladder spec
+(`SWEEP_FIELDS`); the placement stays the base ladder's. Every value is checked against
+the spec's range (`ladders.spec.FIELD_RULES`), and every cell against the cross-field
+rules, when the file is read. Problems are reported as ``FILE:LINE: ...`` like the
+ladder loader does. Cells are named ``<base>.c<index>`` (grid: row-major in the file's
+parameter order).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+
+from ladders.loader import load_ladder
+from ladders.spec import FIELD_RULES, LadderFieldError, LadderSpec, check_field
+from robot.errors import InputError, LadderSpecError
+
+__all__ = ["SWEEP_FIELDS", "SweepCell", "load_sweep", "parse_sweep_yaml"]
+
+#: Fields a sweep may vary.
+SWEEP_FIELDS: tuple[str, ...] = (
+    "slope_deg", "num_rungs", "rung_spacing_m", "first_rung_height_m", "rung_width_m",
+    "rung_depth_m", "rung_thickness_m", "rung_shape", "rail_spacing_m", "rail_height_m",
+    "rail_radius_m", "friction")
+_TOP_KEYS = ("base", "mode", "samples", "seed", "parameters")
+#: Largest number of cells a sweep may expand to (each cell is a plan per seed).
+MAX_CELLS = 10_000
+
+
+@dataclass(frozen=True)
+class SweepCell:
+    """One ladder of a sweep.
+
+    Attributes:
+        name: ``<base>.c<index>``, the cell's ladder key.
+        spec: the ladder (its ``name`` is the cell name).
+        params: the swept field values of this cell.
+    """
+
+    name: str
+    spec: LadderSpec
+    params: dict[str, Any]
+
+
+class _Problems:
+    def __init__(self, source: str):
+        self.source = source
+        self.items: list[tuple[int, str]] = []
+
+    def add(self, node: yaml.Node | None, message: str) -> None:
+        line = node.start_mark.line + 1 if node is not None else 1
+        self.items.append((line, f"{self.source}:{line}: {message}"))
+
+    def raise_if_any(self) -> None:
+        if self.items:
+            self.items.sort(key=lambda it: it[0])
+            more = len(self.items) - 1
+            raise InputError(self.items[0][1] + (f" (and {more} more problem"
+                                                 f"{'s' * (more > 1)})" if more else ""))
+
+
+def _value(node: yaml.Node) -> Any:
+    return yaml.SafeLoader("").construct_object(node, deep=True)
+
+
+def _mapping(node: yaml.Node, what: str, problems: _Problems
+             ) -> dict[str, tuple[yaml.Node, yaml.Node]] | None:
+    if not isinstance(node, yaml.MappingNode):
+        problems.add(node, f"{what} must be a mapping of keys to values")
+        return None
+    out: dict[str, tuple[yaml.Node, yaml.Node]] = {}
+    for k, v in node.value:
+        key = k.value if isinstance(k, yaml.ScalarNode) else None
+        if not isinstance(key, str):
+            problems.add(k, f"{what}: keys must be plain names")
+        elif key in out:
+            problems.add(k, f"{what}: key '{key}' is given twice")
+        else:
+            out[key] = (k, v)
+    return out
+
+
+def _int(node: yaml.Node, what: str, low: int, high: int, problems: _Problems) -> int | None:
+    v = _value(node)
+    if isinstance(v, bool) or not isinstance(v, int) or not low <= v <= high:
+        problems.add(node, f"field '{what}' = {v!r}: expected an integer in [{low}, {high}]")
+        return None
+    return v
+
+
+def _axis(field: str, node: yaml.Node, mode: str, problems: _Problems):
+    """A parameter's values (grid) or sampler description (random)."""
+    rule = FIELD_RULES[field]
+    path = f"parameters.{field}"
+    if isinstance(node, yaml.SequenceNode):
+        if not node.value:
+            problems.add(node, f"field '{path}' is an empty list")
+            return None
+        vals = []
+        for item in node.value:
+            try:
+                vals.append(check_field(field, _value(item)))
+            except LadderFieldError as exc:
+                problems.add(item, f"field '{path}' {exc.reason}")
+        return ("choice", vals) if len(vals) == len(node.value) else None
+    if isinstance(node, yaml.MappingNode):
+        if rule.kind == "str":
+            problems.add(node, f"field '{path}' is a string field: give a list of values, "
+                         f"{rule.describe()}")
+            return None
+        items = _mapping(node, f"field '{path}'", problems) or {}
+        wanted = ("min", "max", "steps") if mode == "grid" else ("min", "max")
+        for key, (knode, _) in items.items():
+            if key not in wanted:
+                problems.add(knode, f"field '{path}.{key}' is unknown; valid keys here: "
+                             f"{', '.join(wanted)}")
+        ok = True
+        bounds = {}
+        for key in ("min", "max"):
+            if key not in items:
+                problems.add(node, f"field '{path}.{key}' is missing ({rule.describe()})")
+                ok = False
+                continue
+            try:
+                bounds[key] = check_field(field, _value(items[key][1]))
+            except LadderFieldError as exc:
+                problems.add(items[key][1], f"field '{path}.{key}' {exc.reason}")
+                ok = False
+        if ok and bounds["min"] > bounds["max"]:
+            problems.add(node, f"field '{path}': min {bounds['min']:g} > max {bounds['max']:g}")
+            ok = False
+        if mode == "grid":
+            if "steps" not in items:
+                problems.add(node, f"field '{path}.steps' is missing (an integer in [1, 100])")
+                return None
+            steps = _int(items["steps"][1], f"{path}.steps", 1, 100, problems)
+            if not ok or steps is None:
+                return None
+            vals = np.linspace(bounds["min"], bounds["max"], steps)
+            if rule.kind == "int":
+                vals = sorted({int(round(v)) for v in vals})
+            return "choice", [v if rule.kind == "int" else float(round(v, 9)) for v in vals]
+        if not ok:
+            return None
+        return "uniform", (bounds["min"], bounds["max"])
+    problems.add(node, f"field '{path}' must be a list of values or a mapping "
+                 f"{{min, max{', steps' if mode == 'grid' else ''}}}")
+    return None
+
+
+def parse_sweep_yaml(text: str, source: str = "<string>",
+                     base_dir: str | os.PathLike[str] = ".") -> list[SweepCell]:
+    """Parse and validate a sweep file and expand it into ladders.
+
+    Args:
+        text: the YAML text (layout in the module docstring).
+        source: file name for messages.
+        base_dir: directory a relative ``base`` spec path is resolved against.
+
+    Returns:
+        The sweep's cells, in order.
+
+    Raises:
+        InputError: ``SOURCE:LINE: ...`` naming the field and the allowed values.
+    """
+    problems = _Problems(source)
+    try:
+        root = yaml.compose(text, Loader=yaml.SafeLoader)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        line = mark.line + 1 if mark is not None else 1
+        raise InputError(f"{source}:{line}: YAML syntax error: "
+                         f"{getattr(exc, 'problem', None) or exc}") from None
+    if root is None:
+        raise InputError(f"{source}:1: the file is empty; expected keys "
+                         f"{', '.join(_TOP_KEYS)}")
+    top = _mapping(root, "the document", problems)
+    problems.raise_if_any()
+    assert top is not None
+    for key, (knode, _) in top.items():
+        if key not in _TOP_KEYS:
+            problems.add(knode, f"field '{key}' is unknown; valid keys: {', '.join(_TOP_KEYS)}")
+    for key in ("base", "parameters"):
+        if key not in top:
+            problems.add(root, f"field '{key}' is missing")
+    problems.raise_if_any()
+
+    mode = "grid"
+    if "mode" in top:
+        mode = _value(top["mode"][1])
+        if mode not in ("grid", "random"):
+            problems.add(top["mode"][1], f"field 'mode' = {mode!r}: one of 'grid', 'random'")
+            mode = "grid"
+    samples = seed = None
+    if mode == "random":
+        if "samples" not in top:
+            problems.add(root, "field 'samples' is missing (mode random: an integer in "
+                         f"[1, {MAX_CELLS}])")
+        else:
+            samples = _int(top["samples"][1], "samples", 1, MAX_CELLS, problems)
+        seed = (_int(top["seed"][1], "seed", 0, 2**32 - 1, problems) if "seed" in top else 0)
+    else:
+        for key in ("samples", "seed"):
+            if key in top:
+                problems.add(top[key][0], f"field '{key}' is only used with mode: random")
+
+    base_node = top["base"][1]
+    base_name = _value(base_node)
+    base: LadderSpec | None = None
+    if not isinstance(base_name, str):
+        problems.add(base_node, f"field 'base' = {base_name!r}: a bundled ladder name or a "
+                     "spec file path")
+    else:
+        arg = base_name
+        if ("/" in arg or arg.endswith((".yaml", ".yml"))) and not os.path.isabs(arg):
+            arg = str(Path(base_dir) / arg)
+        try:
+            base = load_ladder(arg)
+        except LadderSpecError as exc:
+            problems.add(base_node, f"field 'base': {exc}")
+
+    params = _mapping(top["parameters"][1], "field 'parameters'", problems) or {}
+    if not params and isinstance(top["parameters"][1], yaml.MappingNode):
+        problems.add(top["parameters"][1], "field 'parameters' is empty; sweep at least one "
+                     f"of {', '.join(SWEEP_FIELDS)}")
+    axes: dict[str, tuple[str, Any]] = {}
+    for field, (knode, vnode) in params.items():
+        if field not in SWEEP_FIELDS:
+            problems.add(knode, f"field 'parameters.{field}' cannot be swept; sweepable: "
+                         f"{', '.join(SWEEP_FIELDS)}")
+            continue
+        axis = _axis(field, vnode, mode, problems)
+        if axis is not None:
+            axes[field] = axis
+    problems.raise_if_any()
+    assert base is not None
+
+    names = list(axes)
+    combos: list[dict[str, Any]] = []
+    if mode == "grid":
+        total = int(np.prod([len(axes[f][1]) for f in names]))
+        if total > MAX_CELLS:
+            problems.add(top["parameters"][1], f"the grid has {total} cells; at most "
+                         f"{MAX_CELLS} are allowed")
+            problems.raise_if_any()
+        for values in itertools.product(*(axes[f][1] for f in names)):
+            combos.append(dict(zip(names, values, strict=True)))
+    else:
+        rng = np.random.default_rng(seed)
+        for _ in range(samples or 0):
+            combo: dict[str, Any] = {}
+            for f in names:
+                kind, spec = axes[f]
+                if kind == "choice":
+                    v = spec[int(rng.integers(len(spec)))]
+                else:
+                    v = float(rng.uniform(*spec))
+                    if FIELD_RULES[f].kind == "int":
+                        v = int(round(v))
+                combo[f] = v
+            combos.append(combo)
+
+    width = max(3, len(str(len(combos) - 1)))
+    cells = []
+    for i, combo in enumerate(combos):
+        name = f"{base.name}.c{i:0{width}d}"
+        try:
+            spec = dataclasses.replace(base, name=name, **combo)
+        except LadderSpecError as exc:
+            where = params[next(iter(combo))][0] if combo else root
+            problems.add(where, f"cell {name} ({_describe(combo)}) is not a valid ladder: "
+                         f"{exc}")
+            continue
+        cells.append(SweepCell(name, spec, combo))
+    problems.raise_if_any()
+    return cells
+
+
+def _describe(combo: dict[str, Any]) -> str:
+    return ", ".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}"
+                     for k, v in combo.items())
+
+
+def load_sweep(path: str | os.PathLike[str]) -> list[SweepCell]:
+    """Read a sweep file; see `parse_sweep_yaml`.
+
+    Raises:
+        InputError: unreadable file, or ``FILE:LINE: ...`` for a bad sweep.
+    """
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"{p}: cannot read sweep file: "
+                         f"{getattr(exc, 'strerror', None) or exc}") from None
+    return parse_sweep_yaml(text, str(p), p.parent)
