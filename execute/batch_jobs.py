@@ -30,7 +30,7 @@ import signal
 import threading
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -57,7 +57,7 @@ class PlanJob:
         time_limit_s: planning time limit [s].
         top_rung: climb until both feet are on this rung (None: the planner's highest).
         rate_hz: trajectory rate [Hz].
-        sweep: swept parameter values of the ladder's sweep cell (empty: no sweep).
+        sweep: swept (field, value) pairs of the ladder's sweep cell (empty: no sweep).
     """
 
     ladder_key: str
@@ -67,7 +67,7 @@ class PlanJob:
     time_limit_s: float = 600.0
     top_rung: int | None = None
     rate_hz: float = 200.0
-    sweep: dict[str, Any] = field(default_factory=dict)
+    sweep: tuple[tuple[str, Any], ...] = ()
 
     kind = "plan"
 
@@ -92,7 +92,7 @@ class PlanJob:
     def describe(self) -> dict:
         """The job's identity fields of a results record."""
         return {"key": self.key, "fingerprint": self.fingerprint, "kind": self.kind,
-                "ladder": self.ladder_key, "seed": self.seed, "sweep": self.sweep}
+                "ladder": self.ladder_key, "seed": self.seed, "sweep": dict(self.sweep)}
 
 
 @dataclass(frozen=True)
@@ -126,7 +126,7 @@ class ValidateJob:
     def describe(self) -> dict:
         return {"key": self.key, "fingerprint": self.fingerprint, "kind": self.kind,
                 "ladder": self.plan.ladder_key, "seed": self.plan.seed,
-                "sweep": self.plan.sweep, "strategy": self.strategy,
+                "sweep": dict(self.plan.sweep), "strategy": self.strategy,
                 "draw": self.draw_index, "perturbation": self.draw.to_json()}
 
 
@@ -152,7 +152,7 @@ def expand_jobs(ladders: Sequence[tuple[str, LadderSpec, dict[str, Any]]], seeds
     for key, spec, sweep in ladders:
         for seed in seeds:
             p = PlanJob(key, spec, int(seed), robot, time_limit_s, top_rung, rate_hz,
-                        dict(sweep))
+                        tuple(sweep.items()))
             plans.append(p)
             for strategy in strategies:
                 for i in range(draws):

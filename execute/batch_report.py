@@ -179,12 +179,14 @@ def _plan_rows(summary: Summary) -> tuple[list[str], list[list[str]]]:
 
 def print_summary(summary: Summary, console) -> None:
     """Print the success table, the planning table and the cause totals (rich)."""
+    from rich.markup import escape
     from rich.table import Table
 
     head, body = _table_rows(summary)
+    body = [[escape(c) for c in row] for row in body]
     t = Table(title="success rate per ladder × strategy (95 % Wilson interval)")
     for h in head:
-        t.add_column(h, justify="left" if h in ("ladder", "strategy", "failure causes")
+        t.add_column(escape(h), justify="left" if h in ("ladder", "strategy", "failure causes")
                      else "right", overflow="fold")
     for row in body:
         t.add_row(*row)
@@ -192,13 +194,14 @@ def print_summary(summary: Summary, console) -> None:
     head, body = _plan_rows(summary)
     t = Table(title="planning per ladder")
     for h in head:
-        t.add_column(h, overflow="fold")
+        t.add_column(escape(h), overflow="fold")
     for row in body:
-        t.add_row(*row)
+        t.add_row(*(escape(c) for c in row))
     console.print(t)
     causes = summary.causes()
     if causes:
-        console.print("failure causes: " + _causes(dict(causes.most_common())), highlight=False)
+        console.print("failure causes: " + _causes(dict(causes.most_common())), highlight=False,
+                      markup=False)
 
 
 def write_csv(summary: Summary, path: str | Path) -> Path:

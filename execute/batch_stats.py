@@ -48,8 +48,10 @@ def wilson_interval(successes: int, n: int, z: float = Z_95) -> tuple[float, flo
     denom = 1.0 + z2 / n
     centre = (p + z2 / (2 * n)) / denom
     half = z / denom * math.sqrt(p * (1 - p) / n + z2 / (4 * n * n))
-    # k = 0 and k = n are exactly 0 and 1 in theory; keep rounding from leaving [0, 1].
-    return max(0.0, centre - half), min(1.0, centre + half)
+    # k = 0 and k = n give exactly 0 and 1 in theory; rounding must not move them.
+    lo = 0.0 if successes == 0 else max(0.0, centre - half)
+    hi = 1.0 if successes == n else min(1.0, centre + half)
+    return lo, hi
 
 
 @dataclass(frozen=True)
