@@ -22,9 +22,9 @@ __all__ = ["NONDETERMINISTIC_FIELDS", "ResultsLog", "comparable"]
 
 log = logging.getLogger(__name__)
 
-#: Fields that depend on the machine and the moment, not on the job's inputs.
+#: Fields that depend on the machine, the moment or the engine, not on the job's inputs.
 NONDETERMINISTIC_FIELDS = ("wall_s", "finished_at", "worker", "plan_s", "search_s",
-                           "real_time_factor")
+                           "real_time_factor", "traceback")
 
 
 def comparable(record: dict) -> dict:

@@ -1,0 +1,136 @@
+"""batch-eval: bad input exits 2 naming the option; a small run writes its tables and
+plots; one real plan-and-validate run on the cheapest case (stair, first rung).
+
+Not covered by a test (too slow for the suite): a full-height climb (``--top-rung``
+unset, ~50 s of planning and ~30 s of simulation per DRC job); `bench/bench_batch.py`
+and the measurement in the issue cover it."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import sys
+from pathlib import Path
+
+import pytest
+from rich.console import Console
+
+sys.path.insert(0, str(Path(__file__).parent))
+
+import batch_small_jobs as small  # noqa: E402
+
+from execute.batch_cli import main, parse_args, run  # noqa: E402
+from execute.batch_jobs import JobFunctions  # noqa: E402
+from execute.batch_runner import RESULTS_FILE  # noqa: E402
+from execute.verdict import Failure  # noqa: E402
+
+SMALL = JobFunctions(plan=small.small_plan, validate=small.small_validate)
+
+
+@pytest.mark.parametrize("argv,words", [
+    (["--seeds", "0"], ["--seeds is 0", "[1, 10000]"]),
+    (["--seeds", "x"], ["--seeds", "invalid int"]),
+    (["--workers", "0"], ["--workers is 0", "[1, 256]"]),
+    (["--time-limit", "-1"], ["--time-limit is -1", "> 0 s"]),
+    (["--strategies", "mixed,hover"], ["--strategies", "hover", "mixed, position, pwm"]),
+    (["--strategies", "pwm,pwm"], ["--strategies", "pwm given twice"]),
+    (["--ladders", "drc,tower"], ["--ladders", "unknown ladder 'tower'"]),
+    (["--perturb", "placement=3"], ["--perturb placement=3", "(0, 1] m"]),
+    (["--perturb", "wind=3"], ["wind=3", "placement, yaw, rung, friction, battery"]),
+    (["--perturb", "rung=0.2", "--ladders", "stair"], ["rung=0.2", "rung_spacing_m"]),
+    (["--draws", "3"], ["--draws is 3", "no --perturb"]),
+    (["--engine", "ray"], ["--engine", "local or dask"]),
+    (["--address", "tcp://h:8786"], ["--address needs --engine dask"]),
+    (["--engine", "dask", "--address", "h:8786"], ["--address", "tcp://host:8786"]),
+    (["--ladders", "stair", "--top-rung", "4"], ["--top-rung is 4", "0..3"]),
+    (["--ladders", "drc", "--sweep", "s.yaml"], ["not allowed with argument"]),
+])
+def test_bad_flags_exit_2_naming_the_option(argv, words, tmp_path, capsys):
+    assert main([*argv, "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    for w in words:
+        assert w in err, err
+    assert not (tmp_path / RESULTS_FILE).exists()
+
+
+def test_bad_sweep_file_exits_2_with_its_line(tmp_path, capsys):
+    sweep = tmp_path / "s.yaml"
+    sweep.write_text("base: drc\nparameters:\n  slope_deg: [60, 20]\n")
+    assert main(["--sweep", str(sweep), "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert f"{sweep}:3:" in err and "parameters.slope_deg" in err and "[30, 90] deg" in err
+
+
+def _run_small(argv: list[str]) -> tuple[int, str]:
+    out = io.StringIO()
+    console = Console(file=out, width=240, force_terminal=False)
+    err = Console(file=io.StringIO(), width=240)
+    code = run(parse_args(argv), console, err, functions=SMALL)
+    return code, out.getvalue()
+
+
+def test_small_run_prints_and_writes_tables_and_plots(tmp_path):
+    out = tmp_path / "o"
+    code, text = _run_small(["--ladders", "drc,stair", "--seeds", "4", "--perturb",
+                             "placement=0.03", "--draws", "2", "--workers", "2",
+                             "--out", str(out)])
+    assert code == 0
+    assert "success rate per ladder × strategy" in text and "planning per ladder" in text
+    rows = list(csv.DictReader((out / "summary.csv").open()))
+    assert [(r["ladder"], r["strategy"]) for r in rows] == [
+        (lad, s) for lad in ("drc", "stair") for s in ("mixed", "position", "pwm")]
+    for r in rows:
+        assert int(r["runs"]) == 8 and int(r["errors"]) == 0 and int(r["missing"]) == 0
+        assert float(r["ci95_low"]) <= float(r["rate"] or 0) <= float(r["ci95_high"])
+    md = (out / "summary.md").read_text()
+    assert md.count("| drc |") == 3 + 1 and "## Failure causes" in md
+    for name in ("success_per_strategy", "success_vs_slope", "success_vs_spacing"):
+        assert (out / "plots" / f"{name}.png").stat().st_size > 5000
+    records = [json.loads(x) for x in (out / RESULTS_FILE).read_text().splitlines()]
+    assert len(records) == 2 * 4 + 2 * 4 * 3 * 2
+
+
+def test_small_sweep_run_writes_a_heat_map(tmp_path):
+    sweep = tmp_path / "s.yaml"
+    sweep.write_text("base: drc\nmode: grid\nparameters:\n  slope_deg: [50, 60, 70]\n"
+                     "  rung_spacing_m: {min: 0.28, max: 0.32, steps: 2}\n")
+    out = tmp_path / "o"
+    code, text = _run_small(["--sweep", str(sweep), "--seeds", "2", "--strategies",
+                             "mixed,pwm", "--workers", "2", "--out", str(out)])
+    assert code == 0
+    rows = list(csv.DictReader((out / "summary.csv").open()))
+    assert len(rows) == 6 * 2 and {"slope_deg", "rung_spacing_m"} <= set(rows[0])
+    assert rows[0]["ladder"] == "drc.c000" and "drc.c005" in text
+    assert (out / "plots" / "heatmap_rung_spacing_m_slope_deg.png").exists()
+
+
+def test_errored_jobs_give_exit_1(tmp_path):
+    code, _ = _run_small(["--ladders", "drc", "--seeds", "1", "--first-seed",
+                          str(small.RAISE_VALIDATE_SEED), "--workers", "1",
+                          "--out", str(tmp_path)])
+    assert code == 1
+
+
+def test_real_plan_and_validate_on_the_stair_first_rung(tmp_path, capsys):
+    """The real job functions, end to end: plan stair up to rung 0 (~6 s), then play it
+    with the three strategies (each ends within ~20 s of simulated time)."""
+    out = tmp_path / "real"
+    code = main(["--ladders", "stair", "--top-rung", "0", "--seeds", "1", "--perturb",
+                 "placement=0.01", "--workers", "2", "--out", str(out), "--no-plots"])
+    text = capsys.readouterr().out
+    assert code == 0, text
+    recs = {r["key"]: r for r in map(json.loads, (out / RESULTS_FILE).read_text().splitlines())}
+    plan = recs.pop("plan/stair/s1")
+    assert plan["status"] == "ok" and plan["outcome"] in ("planned", "no_plan")
+    assert len(recs) == 3
+    causes = set(Failure.__doc__.replace("``", " ").replace(",", " ").split())
+    for r in recs.values():
+        assert r["status"] == "ok" and r["outcome"] in ("climbed", "failed")
+        if plan["outcome"] == "planned":
+            # the record carries validate-plan's own result: cause, why and metrics
+            assert r["result"]["strategy"] == r["strategy"]
+            assert r["result"]["placement_error"]["dx_m"] == r["perturbation"]["dx_m"]
+            assert r["outcome"] == "climbed" or r["cause"] in causes
+            assert r["why"] and r["simulated_s"] > 0
+    assert "stair" in text and "mixed" in text
