@@ -224,9 +224,12 @@ def run(opts: dict, console, err, functions=None, engine=None) -> int:
                               functions=functions or DEFAULT_JOB_FUNCTIONS,
                               on_start=on_start, on_record=on_record,
                               max_jobs=opts["max_jobs"])
-        finally:
-            if engine is None:
-                eng.close()
+        except BaseException:
+            if engine is None:  # interrupted: drop queued jobs, do not wait for them
+                eng.close(cancel=True)
+            raise
+        if engine is None:
+            eng.close()
     expected: dict[tuple[str, str], int] = {}
     for v in validations:
         k = (v.plan.ladder_key, v.strategy)
