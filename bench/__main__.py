@@ -1,6 +1,6 @@
 """``make bench``: run every benchmark and print its figures against the targets.
 
-Usage: ``python -m bench [--only planner,sim,daemon,channels,can] [--json FILE]``.
+Usage: ``python -m bench [--only planner,sim,daemon,channels,can,batch] [--json FILE]``.
 Figures are measurements on this machine; a target missed is shown, not hidden.
 """
 
@@ -12,7 +12,7 @@ import json
 import sys
 import time
 
-SUITES = ("planner", "sim", "daemon", "channels", "can")
+SUITES = ("planner", "sim", "daemon", "channels", "can", "batch")
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -125,11 +125,31 @@ def test_first_segment_without_motion_keeps_the_start_line():
     assert timed.segment_of_line[0] == 0 and timed.skipped == [0]
 
 
-def test_toppra_returning_none_raises_naming_the_segment(monkeypatch):
+def test_toppra_returning_none_falls_back_to_a_trapezoid_within_the_limits(monkeypatch):
+    """toppra reports failure by returning None; the segment is then timed rest to rest by
+    the conservative trapezoid, and its samples still meet the nominal limits."""
     monkeypatch.setattr(timing, "_toppra_trajectory", lambda *a, **k: None)
     seg = _ramp("moveLHand@rung2/limb", np.zeros(40), "LSP", 0.2, 10)
-    with pytest.raises(TimingError, match=r"moveLHand@rung2/limb: toppra found no time"):
-        time_parameterize([seg], LIMITS)
+    timed = time_parameterize([seg], LIMITS)
+    lines = timed.columns_rad
+    np.testing.assert_array_equal(lines[0], np.zeros(40))
+    assert lines[-1, JOINT_INDEX["LSP"]] == pytest.approx(0.2)
+    timing._check_samples("fallback", lines, 200.0, LIMITS, 1e-6)
+    # Rest to rest: a 0.2 rad move at ≤ 0.9 × 0.8 rad/s² takes at least 2·sqrt(0.2 / 0.72) s.
+    assert timed.durations_s[0] >= 2 * np.sqrt(0.2 / (0.9 * 0.8)) * 0.99
+
+
+def test_trapezoid_respects_curvature_and_speed_bounds():
+    s = np.linspace(0.0, 1.0, 11)
+    way = np.zeros((11, 40))
+    way[:, JOINT_INDEX["LSP"]] = np.sin(3 * s)  # a curved path in one joint
+    way[:, JOINT_INDEX["LEB"]] = -s
+    traj = timing._TrapezoidTrajectory(s, way, LIMITS.velocity_nominal_rad_s,
+                                       LIMITS.accel_nominal_rad_s2)
+    ts = np.linspace(0.0, traj.duration, int(traj.duration * 200) + 1)
+    lines = traj(ts)
+    timing._check_samples("trapezoid", lines, 200.0, LIMITS, 1e-3)
+    np.testing.assert_allclose(lines[-1], way[-1], atol=1e-9)
 
 
 def test_sample_check_names_segment_line_and_joint():
