@@ -37,9 +37,8 @@ from typing import Any
 
 import yaml
 
-from robot.errors import LadderSpecError
-
 from ladders.spec import FIELD_RULES, LadderFieldError, LadderSpec, check_field
+from robot.errors import LadderSpecError
 
 logger = logging.getLogger(__name__)
 

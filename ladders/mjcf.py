@@ -5,10 +5,9 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from robot.mjcf import ENV_CONAFFINITY, ENV_CONTYPE
-
 from ladders.geometry import SIDES, LadderGeometry
 from ladders.spec import LadderSpec
+from robot.mjcf import ENV_CONAFFINITY, ENV_CONTYPE
 
 #: Torsional and rolling friction of ladder contacts (MuJoCo's defaults).
 TORSIONAL_FRICTION = 0.005

@@ -7,13 +7,12 @@ import math
 import mujoco
 import numpy as np
 
-from robot.kinematic_tree import build_tree
-from robot.mjcf import add_floor, add_robot, new_spec
-from robot.params import RobotParams, robot_params
-
 from ladders.geometry import LadderGeometry
 from ladders.mjcf import add_ladder
 from ladders.spec import LadderSpec
+from robot.kinematic_tree import build_tree
+from robot.mjcf import add_floor, add_robot, new_spec
+from robot.params import RobotParams, robot_params
 
 #: Vertical field of view of the side camera [deg] (MuJoCo's default).
 SIDE_CAMERA_FOVY_DEG = 45.0
