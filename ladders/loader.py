@@ -81,11 +81,9 @@ class _Problems:
         if not self.items:
             return
         self.items.sort(key=lambda item: item[0])
-        first = self.items[0][1]
-        more = len(self.items) - 1
-        error = LadderSpecError(first + (f" (and {more} more problem{'s' * (more > 1)})"
-                                         if more else ""))
-        error.problems = [msg for _, msg in self.items]  # type: ignore[attr-defined]
+        problems = [msg for _, msg in self.items]
+        error = LadderSpecError("\n".join(problems))  # every problem, one per line
+        error.problems = problems  # type: ignore[attr-defined]
         raise error
 
 

@@ -1,0 +1,29 @@
+"""The MuJoCo scene of each bundled ladder with the robot standing in front of it."""
+
+import mujoco
+import numpy as np
+import pytest
+
+from ladders.loader import load_ladder
+from ladders.scene import build_scene
+
+
+@pytest.mark.parametrize("name", ["drc", "ship", "stair"])
+def test_scene_holds_the_robot_standing_for_two_seconds(name):
+    model = build_scene(load_ladder(name)).compile()
+    data = mujoco.MjData(model)
+    mujoco.mj_resetDataKeyframe(model, data, 0)
+    mujoco.mj_forward(model, data)
+    ladder_geoms = {model.geom(i).name for i in range(model.ngeom)
+                    if model.geom(i).name.startswith(("rung", "rail", "stringer"))}
+    assert {"rung_0", "rail_left", "rail_right"} <= ladder_geoms
+    z0 = data.qpos[2]
+    for _ in range(int(2.0 / model.opt.timestep)):
+        mujoco.mj_step(model, data)
+        for c in data.contact[:data.ncon]:  # the robot does not touch the ladder
+            names = {model.geom(c.geom1).name, model.geom(c.geom2).name}
+            assert not names & ladder_geoms, names
+    assert abs(data.qpos[2] - z0) < 0.01
+    tilt = 2 * np.arccos(min(1.0, abs(data.qpos[3])))
+    assert tilt < np.radians(1.0)
+    assert all(data.warning[i].number == 0 for i in range(len(data.warning)))
