@@ -29,7 +29,7 @@ import threading
 
 import numpy as np
 
-from robot.errors import HuboLadderError, InputError
+from robot.errors import HuboLadderError, InputError, run_cli
 
 __all__ = ["main", "status_line"]
 
@@ -174,14 +174,7 @@ def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
                         format="%(name)s: %(message)s")
-    try:
-        return _run(args)
-    except InputError as exc:
-        print(f"hubo-daemon: {exc}", file=sys.stderr)
-        return 2
-    except HuboLadderError as exc:
-        print(f"hubo-daemon: {exc}", file=sys.stderr)
-        return 1
+    return run_cli("hubo-daemon", lambda: _run(args))
 
 
 if __name__ == "__main__":

@@ -20,7 +20,7 @@ import time
 
 import numpy as np
 
-from robot.errors import HuboLadderError, InputError
+from robot.errors import HuboLadderError, InputError, run_cli
 
 __all__ = ["main", "state_table"]
 
@@ -128,14 +128,7 @@ def main(argv: list[str] | None = None) -> int:
                    help="table refresh rate (default 5 Hz)")
     p.add_argument("--once", action="store_true", help="print one table and exit")
     args = p.parse_args(argv)
-    try:
-        return _run(args)
-    except InputError as exc:
-        print(f"hubo-read: {exc}", file=sys.stderr)
-        return 2
-    except HuboLadderError as exc:
-        print(f"hubo-read: {exc}", file=sys.stderr)
-        return 1
+    return run_cli("hubo-read", lambda: _run(args))
 
 
 if __name__ == "__main__":

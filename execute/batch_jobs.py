@@ -22,12 +22,9 @@ Exceptions are not caught here: the runner records them as the job's error.
 
 from __future__ import annotations
 
-import contextlib
 import dataclasses
 import hashlib
 import json
-import signal
-import threading
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -36,6 +33,7 @@ from typing import Any
 
 from execute.batch_perturb import Draw, PerturbSpec, draw
 from ladders.spec import LadderSpec
+from planner.time_limit import HARD_LIMIT_GRACE_S, TimeLimitExceeded, hard_time_limit
 
 __all__ = ["DEFAULT_JOB_FUNCTIONS", "HARD_LIMIT_GRACE_S", "JobFunctions", "PlanJob",
            "ValidateJob", "expand_jobs", "plan_job", "validate_job"]
@@ -161,33 +159,6 @@ def expand_jobs(ladders: Sequence[tuple[str, LadderSpec, dict[str, Any]]], seeds
     return plans, validations
 
 
-#: Planning is stopped this long after its time limit when the search overruns it [s].
-HARD_LIMIT_GRACE_S = 0.5
-
-
-class _TimeUp(Exception):
-    pass
-
-
-@contextlib.contextmanager
-def _hard_time_limit(seconds: float):
-    """SIGALRM after ``seconds`` in a worker's main thread (process pools); elsewhere
-    (Dask worker threads) the planner's own between-sample check is all there is."""
-    if threading.current_thread() is not threading.main_thread() or \
-            not hasattr(signal, "setitimer"):
-        yield
-        return
-
-    def on_alarm(signum, frame):
-        raise _TimeUp
-
-    previous = signal.signal(signal.SIGALRM, on_alarm)
-    signal.setitimer(signal.ITIMER_REAL, seconds)
-    try:
-        yield
-    finally:
-        signal.setitimer(signal.ITIMER_REAL, 0)
-        signal.signal(signal.SIGALRM, previous)
 
 
 def plan_job(job: PlanJob, out_dir: str) -> dict:
@@ -210,13 +181,13 @@ def plan_job(job: PlanJob, out_dir: str) -> dict:
                            config=PlannerConfig(time_limit_s=job.time_limit_s), seed=job.seed)
     top = planner.top_rung() if job.top_rung is None else job.top_rung
     try:
-        with _hard_time_limit(job.time_limit_s + HARD_LIMIT_GRACE_S):
+        with hard_time_limit(job.time_limit_s + HARD_LIMIT_GRACE_S):
             result = planner.plan(top_rung=top)
     except PlanningFailed as exc:
         return {"outcome": "no_plan", "cause": "no_plan", "plan_s": time.perf_counter() - t0,
                 "top_rung": top, "why": f"{exc.step.primitive.name} at rung {exc.step.rung}: "
                                         f"{exc.reason}"}
-    except _TimeUp:
+    except TimeLimitExceeded:
         return {"outcome": "no_plan", "cause": "no_plan", "plan_s": time.perf_counter() - t0,
                 "top_rung": top, "why": f"time limit of {job.time_limit_s:g} s reached"}
     search_s = time.perf_counter() - t0

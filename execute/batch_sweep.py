@@ -33,7 +33,7 @@ from typing import Any
 import numpy as np
 import yaml
 
-from ladders.loader import load_ladder
+from ladders.loader import YamlProblems, load_ladder, mapping_items
 from ladders.spec import FIELD_RULES, LadderFieldError, LadderSpec, check_field
 from robot.errors import InputError, LadderSpecError
 
@@ -64,45 +64,11 @@ class SweepCell:
     params: dict[str, Any]
 
 
-class _Problems:
-    def __init__(self, source: str):
-        self.source = source
-        self.items: list[tuple[int, str]] = []
-
-    def add(self, node: yaml.Node | None, message: str) -> None:
-        line = node.start_mark.line + 1 if node is not None else 1
-        self.items.append((line, f"{self.source}:{line}: {message}"))
-
-    def raise_if_any(self) -> None:
-        if self.items:
-            self.items.sort(key=lambda it: it[0])
-            more = len(self.items) - 1
-            raise InputError(self.items[0][1] + (f" (and {more} more problem"
-                                                 f"{'s' * (more > 1)})" if more else ""))
-
-
 def _value(node: yaml.Node) -> Any:
     return yaml.SafeLoader("").construct_object(node, deep=True)
 
 
-def _mapping(node: yaml.Node, what: str, problems: _Problems
-             ) -> dict[str, tuple[yaml.Node, yaml.Node]] | None:
-    if not isinstance(node, yaml.MappingNode):
-        problems.add(node, f"{what} must be a mapping of keys to values")
-        return None
-    out: dict[str, tuple[yaml.Node, yaml.Node]] = {}
-    for k, v in node.value:
-        key = k.value if isinstance(k, yaml.ScalarNode) else None
-        if not isinstance(key, str):
-            problems.add(k, f"{what}: keys must be plain names")
-        elif key in out:
-            problems.add(k, f"{what}: key '{key}' is given twice")
-        else:
-            out[key] = (k, v)
-    return out
-
-
-def _int(node: yaml.Node, what: str, low: int, high: int, problems: _Problems) -> int | None:
+def _int(node: yaml.Node, what: str, low: int, high: int, problems: YamlProblems) -> int | None:
     v = _value(node)
     if isinstance(v, bool) or not isinstance(v, int) or not low <= v <= high:
         problems.add(node, f"field '{what}' = {v!r}: expected an integer in [{low}, {high}]")
@@ -110,7 +76,7 @@ def _int(node: yaml.Node, what: str, low: int, high: int, problems: _Problems) -
     return v
 
 
-def _axis(field: str, node: yaml.Node, mode: str, problems: _Problems):
+def _axis(field: str, node: yaml.Node, mode: str, problems: YamlProblems):
     """A parameter's values (grid) or sampler description (random)."""
     rule = FIELD_RULES[field]
     path = f"parameters.{field}"
@@ -130,7 +96,7 @@ def _axis(field: str, node: yaml.Node, mode: str, problems: _Problems):
             problems.add(node, f"field '{path}' is a string field: give a list of values, "
                          f"{rule.describe()}")
             return None
-        items = _mapping(node, f"field '{path}'", problems) or {}
+        items = mapping_items(node, f"field '{path}'", problems) or {}
         wanted = ("min", "max", "steps") if mode == "grid" else ("min", "max")
         for key, (knode, _) in items.items():
             if key not in wanted:
@@ -185,7 +151,7 @@ def parse_sweep_yaml(text: str, source: str = "<string>",
     Raises:
         InputError: ``SOURCE:LINE: ...`` naming the field and the allowed values.
     """
-    problems = _Problems(source)
+    problems = YamlProblems(source, InputError)
     try:
         root = yaml.compose(text, Loader=yaml.SafeLoader)
     except yaml.YAMLError as exc:
@@ -196,7 +162,7 @@ def parse_sweep_yaml(text: str, source: str = "<string>",
     if root is None:
         raise InputError(f"{source}:1: the file is empty; expected keys "
                          f"{', '.join(_TOP_KEYS)}")
-    top = _mapping(root, "the document", problems)
+    top = mapping_items(root, "the document", problems)
     problems.raise_if_any()
     assert top is not None
     for key, (knode, _) in top.items():
@@ -241,7 +207,7 @@ def parse_sweep_yaml(text: str, source: str = "<string>",
         except LadderSpecError as exc:
             problems.add(base_node, f"field 'base': {exc}")
 
-    params = _mapping(top["parameters"][1], "field 'parameters'", problems) or {}
+    params = mapping_items(top["parameters"][1], "field 'parameters'", problems) or {}
     if not params and isinstance(top["parameters"][1], yaml.MappingNode):
         problems.add(top["parameters"][1], "field 'parameters' is empty; sweep at least one "
                      f"of {', '.join(SWEEP_FIELDS)}")

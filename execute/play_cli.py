@@ -38,7 +38,7 @@ from pathlib import Path
 
 import numpy as np
 
-from robot.errors import HuboLadderError, InputError
+from robot.errors import HuboLadderError, InputError, run_cli
 
 __all__ = ["main"]
 
@@ -268,15 +268,12 @@ def main(argv: list[str] | None = None) -> int:
     """Entry point of ``play-trajectory``; returns the exit code."""
     args = _parser().parse_args(argv)
     logging.basicConfig(level=logging.WARNING, format="%(name)s: %(message)s")
-    try:
+    def job() -> int:
         traj, player, auto = _load(args)
         return _play(args, traj, player, auto)
-    except InputError as exc:
-        print(f"play-trajectory: {exc}", file=sys.stderr)
-        return 2
-    except HuboLadderError as exc:
-        print(f"play-trajectory: {exc}", file=sys.stderr)
-        return 1
+
+    try:
+        return run_cli("play-trajectory", job)
     except KeyboardInterrupt:  # before playback started: nothing was sent
         print("play-trajectory: interrupted before playing", file=sys.stderr)
         return 130

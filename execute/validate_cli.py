@@ -21,7 +21,7 @@ import os
 import sys
 from pathlib import Path
 
-from robot.errors import HuboLadderError, InputError
+from robot.errors import InputError, run_cli
 
 __all__ = ["ladder_from_sidecar", "main", "result_json"]
 
@@ -157,14 +157,7 @@ def main(argv: list[str] | None = None) -> int:
         os.environ.setdefault("MUJOCO_GL", "egl")  # before mujoco is imported
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
                         format="%(name)s: %(message)s")
-    try:
-        return _run(args)
-    except InputError as exc:
-        print(f"validate-plan: {exc}", file=sys.stderr)
-        return 2
-    except HuboLadderError as exc:
-        print(f"validate-plan: {exc}", file=sys.stderr)
-        return 1
+    return run_cli("validate-plan", lambda: _run(args))
 
 
 if __name__ == "__main__":

@@ -38,7 +38,7 @@ from typing import Any
 import yaml
 
 from ladders.spec import FIELD_RULES, LadderFieldError, LadderSpec, check_field
-from robot.errors import LadderSpecError
+from robot.errors import InputError, LadderSpecError
 
 logger = logging.getLogger(__name__)
 
@@ -66,11 +66,13 @@ FILE_KEYS: dict[str, str] = {
 }
 
 
-class _Problems:
-    """Collects ``FILE:LINE: message`` problems; raises them as one `LadderSpecError`."""
+class YamlProblems:
+    """Collects ``FILE:LINE: message`` problems of a YAML file; raises them all at once
+    as one error (a `LadderSpecError` unless told otherwise), one problem per line."""
 
-    def __init__(self, source: str):
+    def __init__(self, source: str, error: type[InputError] = LadderSpecError):
         self.source = source
+        self.error = error
         self.items: list[tuple[int, str]] = []
 
     def add(self, node: yaml.Node | None, message: str) -> None:
@@ -82,12 +84,12 @@ class _Problems:
             return
         self.items.sort(key=lambda item: item[0])
         problems = [msg for _, msg in self.items]
-        error = LadderSpecError("\n".join(problems))  # every problem, one per line
+        error = self.error("\n".join(problems))
         error.problems = problems  # type: ignore[attr-defined]
         raise error
 
 
-def _mapping_items(node: yaml.Node, what: str, problems: _Problems
+def mapping_items(node: yaml.Node, what: str, problems: YamlProblems
                    ) -> dict[str, tuple[yaml.Node, yaml.Node]] | None:
     """The ``{key: (key node, value node)}`` of a mapping node, or None (problem noted)."""
     if not isinstance(node, yaml.MappingNode):
@@ -130,7 +132,7 @@ def parse_ladder_yaml(text: str, source: str = "<string>") -> LadderSpec:
             not a mapping, unknown/missing/duplicate keys, wrong types, out-of-range values
             and cross-field rule violations.
     """
-    problems = _Problems(source)
+    problems = YamlProblems(source)
     try:
         root = yaml.compose(text, Loader=yaml.SafeLoader)
     except yaml.YAMLError as exc:
@@ -141,7 +143,7 @@ def parse_ladder_yaml(text: str, source: str = "<string>") -> LadderSpec:
     if root is None:
         raise LadderSpecError(f"{source}:1: the file is empty; expected a ladder spec mapping "
                               f"with sections {', '.join(s for s in LAYOUT if s)}")
-    top = _mapping_items(root, "the document", problems)
+    top = mapping_items(root, "the document", problems)
     problems.raise_if_any()
     assert top is not None
     values: dict[str, Any] = {}
@@ -156,7 +158,7 @@ def parse_ladder_yaml(text: str, source: str = "<string>") -> LadderSpec:
             anchor: yaml.Node = root
         elif section in top:
             anchor = top[section][1]
-            entries = _mapping_items(anchor, f"section '{section}'", problems)
+            entries = mapping_items(anchor, f"section '{section}'", problems)
         else:
             anchor, entries = root, {}
         if entries is None:

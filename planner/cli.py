@@ -16,11 +16,8 @@ names the file, field or option).
 from __future__ import annotations
 
 import argparse
-import contextlib
 import logging
-import signal
 import sys
-import threading
 import time
 from pathlib import Path
 
@@ -71,32 +68,6 @@ def _check_args(args: argparse.Namespace) -> None:
 
 
 #: The search checks its time limit between samples; a sample can take seconds. The CLI
-#: stops it this long after the limit regardless [s].
-HARD_LIMIT_GRACE_S = 0.5
-
-
-class _TimeUp(Exception):
-    """Raised by the alarm signal when the planning time is over."""
-
-
-@contextlib.contextmanager
-def _hard_time_limit(seconds: float):
-    """Raise `_TimeUp` in the main thread after ``seconds`` (no-op off the main thread)."""
-    if threading.current_thread() is not threading.main_thread() or \
-            not hasattr(signal, "setitimer"):
-        yield
-        return
-
-    def on_alarm(signum, frame):
-        raise _TimeUp
-
-    previous = signal.signal(signal.SIGALRM, on_alarm)
-    signal.setitimer(signal.ITIMER_REAL, seconds)
-    try:
-        yield
-    finally:
-        signal.setitimer(signal.ITIMER_REAL, 0)
-        signal.signal(signal.SIGALRM, previous)
 
 
 def _summary_table(result, total_s: float, out) -> object:
@@ -132,6 +103,7 @@ def _plan(args: argparse.Namespace, err) -> int:
     from ladders.loader import load_ladder
     from planner.output import write_plan
     from planner.search import ClimbPlanner, PlannerConfig, PlanningFailed
+    from planner.time_limit import HARD_LIMIT_GRACE_S, TimeLimitExceeded, hard_time_limit
     from primitives.library import climb_sequence
 
     t0 = time.perf_counter()
@@ -163,9 +135,9 @@ def _plan(args: argparse.Namespace, err) -> int:
                      stats.samples, stats.backtracks)
 
         try:
-            with _hard_time_limit(args.time_limit + HARD_LIMIT_GRACE_S):
+            with hard_time_limit(args.time_limit + HARD_LIMIT_GRACE_S):
                 result = planner.plan(top_rung=top, progress=on_step)
-        except (PlanningFailed, _TimeUp) as exc:
+        except (PlanningFailed, TimeLimitExceeded) as exc:
             progress.stop()
             step, reason = ((exc.step, exc.reason) if isinstance(exc, PlanningFailed) else
                             (current[0], f"time limit of {args.time_limit:g} s reached"))

@@ -7,6 +7,9 @@ line, column or field and the allowed range.
 
 from __future__ import annotations
 
+import sys
+from collections.abc import Callable
+
 
 class HuboLadderError(Exception):
     """Base class of every error this project raises on purpose."""
@@ -33,3 +36,16 @@ class LadderSpecError(InputError):
 
 class RobotModelError(HuboLadderError):
     """The robot description is inconsistent (a bug in a parameter table)."""
+
+
+def run_cli(prog: str, job: Callable[[], int]) -> int:
+    """Run a command's body; a project error becomes a one-line message on stderr and an
+    exit code: 2 for bad input, 1 when the job ran and failed. Tracebacks are for bugs."""
+    try:
+        return job()
+    except InputError as exc:
+        print(f"{prog}: {exc}", file=sys.stderr)
+        return 2
+    except HuboLadderError as exc:
+        print(f"{prog}: {exc}", file=sys.stderr)
+        return 1
