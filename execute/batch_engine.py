@@ -110,6 +110,10 @@ def dask_engine(address: str | None = None, workers: int = 1, processes: bool = 
     """
     from distributed import Client, LocalCluster
 
+    # distributed sets its own loggers to INFO; keep its chatter out of the user's
+    # terminal unless batch-eval runs verbose (the root logger then passes INFO).
+    if not logging.getLogger().isEnabledFor(logging.INFO):
+        logging.getLogger("distributed").setLevel(logging.WARNING)
     cluster = None
     if address is None:
         cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=processes,
