@@ -557,8 +557,10 @@ def torque_feasibility(model, data, q: np.ndarray, stance: Stance,
     bounds[n_lam, 1] = np.inf
     cost = np.zeros(n_lam + 1)
     cost[-1] = 1.0
+    # Presolve only reformulates this small dense LP: off, the solve is ~25 % faster (it
+    # runs on every interpolated configuration) and the optimum is the same.
     res = linprog(cost, A_ub=a_ub, b_ub=b_ub, A_eq=a_eq, b_eq=b_eq, bounds=bounds,
-                  method="highs")
+                  method="highs", options={"presolve": False})
     if res.status == 2:
         return TorqueCheck(False, False, math.inf, "", joint_names=names)
     if res.status != 0:
