@@ -24,7 +24,7 @@ LIMB_END_LINKS = {
     "left_hand": ("L_hand",) + tuple(f"L_finger{i}" for i in range(1, 6)),
     "right_hand": ("R_hand",) + tuple(f"R_finger{i}" for i in range(1, 6)),
 }
-#: Links of each limb that may touch the held object on the approach (forearm on a rail).
+#: Name of the floor in the environment (a half-space at z = 0).
 FLOOR = "floor"
 
 

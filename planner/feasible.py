@@ -81,8 +81,8 @@ def _descend_torque(kin: HuboKinematics, checker: FeasibilityChecker, q_seed: np
     best_pelvis = q_start[:3].copy() if pelvis is None else pelvis.copy()
     best_posture = dict(posture)
     for name in TORQUE_DESCENT_JOINTS:
-        if name not in best_posture and kin.model.existJointName(name):
-            best_posture[name] = float(q_start[kin.model.joints[kin.model.getJointId(name)].idx_q])
+        if name not in best_posture and name in kin.q_index:
+            best_posture[name] = float(q_start[kin.q_index[name]])
     best_ratio = ratio
     last = None
     for _ in range(TORQUE_DESCENT_EVALUATIONS):

@@ -71,9 +71,14 @@ def contact_space_interpolate(kin: HuboKinematics, checker: FeasibilityChecker,
     """
     stats = stats if stats is not None else InterpolationStats()
     ik_config = ik_config or IKConfig()
+    # Only restore the contacts, staying near the midpoint; stability is checked after.
+    cfg = IKConfig(**{**ik_config.__dict__, "posture_weight": MIDPOINT_POSTURE_WEIGHT,
+                      "torso_upright_weight": 0.0, "moving_tol_m": PROJECTION_TOL_M,
+                      "moving_angle_tol_rad": ik_config.angle_tol_rad})
 
     def rec(q0: np.ndarray, q1: np.ndarray, depth: int) -> list[np.ndarray]:
-        if kin.joint_distance(q0, q1) <= resolution_rad:
+        span = kin.joint_distance(q0, q1)
+        if span <= resolution_rad:
             return [q1]
         if depth >= max_depth:
             raise InterpolationError("resolution not reached", depth)
@@ -84,19 +89,11 @@ def contact_space_interpolate(kin: HuboKinematics, checker: FeasibilityChecker,
                                                 kin.frame_pose(q1, h.frame), 0.5),
                  h.points_m, h.normals, h.friction)
             for h in moving)
-        posture = {name: float(qm[kin.model.joints[kin.model.getJointId(name)].idx_q])
-                   for name in kin.wrapper.joint_names()}
-        cfg = IKConfig(**{**ik_config.__dict__, "posture_weight": MIDPOINT_POSTURE_WEIGHT,
-                          "torso_upright_weight": 0.0,
-                          "moving_tol_m": PROJECTION_TOL_M,
-                          "moving_angle_tol_rad": ik_config.angle_tol_rad})
-        # Only restore the contacts, staying near the midpoint; stability is checked after.
-        res = solve_ik(kin, qm, support, moving_targets, posture_rad=posture, preferences=False,
-                       config=cfg)
+        res = solve_ik(kin, qm, support, moving_targets, posture_rad=kin.posture(qm),
+                       preferences=False, config=cfg)
         stats.projections += 1
         if not res.converged:
             raise InterpolationError(f"projection failed: {res!r}", depth)
-        span = kin.joint_distance(q0, q1)
         if max(kin.joint_distance(q0, res.q), kin.joint_distance(res.q, q1)) > JUMP_RATIO * span:
             worst = int(np.argmax(np.abs(res.q[7:] - qm[7:])))
             raise InterpolationError(

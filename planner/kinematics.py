@@ -28,17 +28,16 @@ class HuboKinematics:
     model: pin.Model
     data: pin.Data
     q_index_of_column: np.ndarray  # (40,) index into q, or -1 for a column with no joint
+    q_index: dict[str, int]  # revolute joint name → its index in q
 
     @classmethod
     def load(cls, robot: str = "drc-hubo") -> HuboKinematics:
         params = robot_params(robot)
         wrapper = placo.RobotWrapper("", placo.Flags.ignore_collisions, robot_urdf(params))
         model = wrapper.model
-        index = np.full(len(JOINT_NAMES), -1)
-        for k, name in enumerate(JOINT_NAMES):
-            if model.existJointName(name):
-                index[k] = model.joints[model.getJointId(name)].idx_q
-        return cls(params, wrapper, model, model.createData(), index)
+        q_index = {model.names[j]: model.joints[j].idx_q for j in range(2, model.njoints)}
+        index = np.array([q_index.get(name, -1) for name in JOINT_NAMES])
+        return cls(params, wrapper, model, model.createData(), index, q_index)
 
     @property
     def q(self) -> np.ndarray:
@@ -54,6 +53,10 @@ class HuboKinematics:
         have = self.q_index_of_column >= 0
         out[have] = q[self.q_index_of_column[have]]
         return out
+
+    def posture(self, q: np.ndarray) -> dict[str, float]:
+        """Every revolute joint's angle in ``q`` [rad], by name."""
+        return {name: float(q[i]) for name, i in self.q_index.items()}
 
     def actuated(self, q: np.ndarray) -> np.ndarray:
         """The revolute part of ``q`` (model order)."""

@@ -149,9 +149,8 @@ class ClimbPlanner:
         q[2] = kin.params.pelvis_height_m
         for side, sign in (("L", 1.0), ("R", -1.0)):
             for joint, v in START_POSTURE.items():
-                if kin.model.existJointName(side + joint):
-                    mirrored = sign * v if joint == "SR" else v
-                    q[kin.model.joints[kin.model.getJointId(side + joint)].idx_q] = mirrored
+                if side + joint in kin.q_index:
+                    q[kin.q_index[side + joint]] = sign * v if joint == "SR" else v
         floor = {}
         for limb, frame in (("left_foot", "L_sole"), ("right_foot", "R_sole")):
             T = np.eye(4)
@@ -184,17 +183,9 @@ class ClimbPlanner:
     def _contacts(self, holds) -> dict[str, str]:
         return {h.limb: h.target for h in holds}
 
-    def _with_fingers(self, q: np.ndarray, side: str, value: float) -> np.ndarray:
-        out = q.copy()
-        for name in FINGER_JOINTS[side]:
-            if self.kin.model.existJointName(name):
-                out[self.kin.model.joints[self.kin.model.getJointId(name)].idx_q] = value
-        return out
-
     def _finger_path(self, q: np.ndarray, side: str, value: float) -> list[np.ndarray]:
         """Open or close a hand in steps no larger than the resolution."""
-        idx = [self.kin.model.joints[self.kin.model.getJointId(n)].idx_q
-               for n in FINGER_JOINTS[side] if self.kin.model.existJointName(n)]
+        idx = [self.kin.q_index[n] for n in FINGER_JOINTS[side] if n in self.kin.q_index]
         start = q[idx].copy()
         n = max(1, int(np.ceil(np.max(np.abs(value - start)) / self.config.resolution_rad)))
         out = []
@@ -236,9 +227,8 @@ class ClimbPlanner:
         for h in support:
             if h.is_hand:
                 for name in ARM_JOINTS[_limb_side(h.limb)]:
-                    if self.kin.model.existJointName(name):
-                        jid = self.kin.model.getJointId(name)
-                        posture[name] = float(q[self.kin.model.joints[jid].idx_q])
+                    if name in self.kin.q_index:
+                        posture[name] = float(q[self.kin.q_index[name]])
         return posture
 
     def _target(self, step: Step, support, moving, stability: Stance, contacts,
