@@ -21,7 +21,7 @@ Actuation, per joint, two MuJoCo actuators on the same hinge:
   it inside MuJoCo rather than computing it in numpy because ``implicitfast`` then
   integrates its damping implicitly, which keeps a stiff geared joint stable at 2.5 ms.
 - *PWM* (added here, ``<joint>_pwm``): an affine actuator that is the DC-motor model of
-  `daemon.dc_motor`: ``τ = g·duty − b·q̇`` with ``g = −η·gear·Kt·V/(100·R)`` and
+  `robot.motors`: ``τ = g·duty − b·q̇`` with ``g = −η·gear·Kt·V/(100·R)`` and
   ``b = η·gear²·Kt·Ke/R``; the battery voltage ``V`` scales ``g``. The back-EMF damping
   ``b`` is large (≈ 56 N·m·s/rad at a shoulder) and is again integrated implicitly. The
   motor's torque is not clamped: over-current trips the board instead.
@@ -32,7 +32,7 @@ no back-EMF braking).
 
 Board trips: `daemon.board_trip` (boards grouped as on the robot; the wrist roll shares
 its board with the fingers, whose grip then lets go). Grip: `daemon.grasp_latch`.
-Sensors: `daemon.sim_sensors`; motor currents and battery power from `daemon.dc_motor`.
+Sensors: `daemon.sim_sensors`; motor currents and battery power from `robot.motors`.
 """
 
 from __future__ import annotations
@@ -46,7 +46,7 @@ import mujoco
 import numpy as np
 
 from daemon.board_trip import BOARDS, BoardTripConfig, BoardTripMonitor, TripEvent
-from daemon.dc_motor import DEFAULT_BATTERY_V, MotorTable, battery_power, motor_table
+from robot.motors import DEFAULT_BATTERY_V, MotorTable, battery_power, motor_table
 from daemon.grasp_latch import GraspEvent, GraspLatch, GripConfig
 from daemon.joint_control import ControlOutput
 from daemon.sim_sensors import SensorIndex, SensorReading, add_sensors, read_sensors

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from daemon.dc_motor import DEFAULT_BATTERY_V
+from robot.motors import DEFAULT_BATTERY_V
 from ladders.spec import FIELD_RULES, LadderSpec
 from robot.errors import InputError
 

@@ -345,7 +345,10 @@ class ClimbPlanner:
 
         # 4. Polish: the new holds become hard tasks, met to solver precision, and the
         # placed configuration must be feasible in the new stance too.
-        polished = solve_ik(self.kin, q_cur, next_stance.holds, config=self.ik_config)
+        # The posture task pins the other joints where they are: near a singular or
+        # limit-bound pose a millimetre of hold error can otherwise swing them far.
+        polished = solve_ik(self.kin, q_cur, next_stance.holds, config=self.ik_config,
+                            posture_rad=self.kin.posture(q_cur), preferences=False)
         if not polished.converged:
             raise _StepRejected(f"placed pose does not meet its holds: {polished!r}")
         correction = self.kin.joint_distance(polished.q, q_cur)

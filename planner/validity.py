@@ -3,7 +3,8 @@
 The one predicate every stage of the search and the interpolation uses (thesis §6.3.1):
 every contact meets its hold, the joints are within limits, nothing collides with the
 environment or the robot itself, and the pose is statically stable (CoM inside the
-stance's support region and joint torques within limits).
+stance's support region and joint torques within limits). Arms whose hands hold a rail
+get the torque their strategy gives them (`planner.arm_capacity`).
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from planner.arm_capacity import DEFAULT_ARM_STRATEGY, gripping_torque_limits
 from planner.collision import CollisionModel
 from planner.contacts import Stance
 from planner.kinematics import HuboKinematics
@@ -45,11 +47,13 @@ class FeasibilityChecker:
     """Caches the support region per stance and checks configurations against it."""
 
     def __init__(self, kin: HuboKinematics, collision: CollisionModel,
-                 min_margin_m: float = 0.0):
+                 min_margin_m: float = 0.0, arm_strategy: str = DEFAULT_ARM_STRATEGY):
         self.kin = kin
         self.collision = collision
         self.min_margin_m = min_margin_m
+        self.arm_strategy = arm_strategy
         self.torque_max = torque_limits_by_joint(kin.params.name)
+        self._torque_limits: dict[frozenset, dict[str, float]] = {}
         self._regions: dict[tuple, SupportRegion] = {}
         lower, upper = kin.model.lowerPositionLimit[7:], kin.model.upperPositionLimit[7:]
         self._lower, self._upper = lower.copy(), upper.copy()
@@ -67,6 +71,14 @@ class FeasibilityChecker:
         if key not in self._regions:
             self._regions[key] = support_region(stance, self.kin.params.total_mass_kg)
         return self._regions[key]
+
+    def torque_limits(self, stance: Stance) -> dict[str, float]:
+        """Torque limit per joint [N·m] while ``stance`` carries the robot."""
+        sides = frozenset(h.limb.split("_")[0] for h in stance.holds if h.is_hand)
+        if sides not in self._torque_limits:
+            self._torque_limits[sides] = gripping_torque_limits(
+                self.torque_max, set(sides), self.arm_strategy)
+        return self._torque_limits[sides]
 
     def check(self, q: np.ndarray, stance: Stance, contacts: dict[str, str]) -> Verdict:
         """Feasibility of ``q`` when ``stance`` carries the robot.
@@ -92,7 +104,7 @@ class FeasibilityChecker:
         if region.is_empty:
             return Verdict(False, "stance cannot balance gravity", -np.inf, np.inf)
         report = check_stability(self.kin.model, self.kin.data, q, stance, region,
-                                 self.torque_max, min_margin_m=self.min_margin_m,
+                                 self.torque_limits(stance), min_margin_m=self.min_margin_m,
                                  frame_ids=self.frame_ids)
         ratio = report.torque.max_ratio if report.torque is not None else np.inf
         if not report.stable:

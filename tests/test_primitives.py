@@ -9,6 +9,7 @@ from ladders.geometry import LadderGeometry
 from ladders.loader import load_ladder
 from planner.holds import make_hold, palm_rotation
 from primitives import RailSeed, RungSeed, climb_sequence
+from primitives.hold_seeds import FOOT_ALONG_M
 from robot.params import DRC_HUBO
 
 
@@ -31,7 +32,7 @@ def test_foot_holds_rest_on_their_rung(name):
     geom = LadderGeometry(spec)
     for rung in (0, spec.num_rungs - 1):
         hold = make_hold(RungSeed("left_foot", rung, 0.11), geom, DRC_HUBO)
-        top = geom.rung_top_point(rung, lateral_m=0.11)
+        top = geom.rung_top_point(rung, lateral_m=0.11, along_m=FOOT_ALONG_M)
         np.testing.assert_allclose(hold.T_world_frame[:3, 3], top, atol=1e-12)
         assert np.all(hold.normals[:, 2] == 1.0) and hold.friction == spec.friction
         # Contact corners lie on the tread, not beyond it.

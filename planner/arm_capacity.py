@@ -1,0 +1,57 @@
+"""How much torque each arm joint can give while its hand holds a rail, per strategy.
+
+The torque LP of `planner.stability` spreads the load over every joint that can carry
+it. Which arm joints can carry how much depends on how the arms will be driven:
+
+- ``position``: both arms rigid; every joint up to its torque limit.
+- ``mixed`` (the thesis's best strategy, the default): an arm whose hand holds a rail is
+  in PWM compliance. Its joints give at most the stall torque of their motor at the PWM
+  clamp of the default gains, ``|η·gear·Kt·V·max_pwm/(100·R)|`` (`robot.motors`,
+  `robot.pwm_gains`): at 48 V about 14 N·m at the shoulders, 5.8–7.2 N·m at the elbows
+  and 1.4 N·m at the wrist pitch, against 27, 23 and 8.9 N·m rigid. The wrist roll
+  cannot be compliant (it sits on the finger board) and keeps its limit.
+
+A plan made for ``position`` arms asks the compliant arms of ``mixed`` for torque they do
+not have: the legs then saturate and their boards trip (validate-plan shows it).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+
+from robot.joints import ARM_JOINTS, JOINT_INDEX
+from robot.motors import DEFAULT_BATTERY_V, motor_table
+from robot.pwm_gains import safe_default_gain_table
+
+__all__ = ["ARM_STRATEGIES", "DEFAULT_ARM_STRATEGY", "compliant_torque_nm",
+           "gripping_torque_limits"]
+
+ARM_STRATEGIES = ("mixed", "position")
+DEFAULT_ARM_STRATEGY = "mixed"
+
+
+def compliant_torque_nm(battery_v: float = DEFAULT_BATTERY_V) -> dict[str, float]:
+    """Stall torque at the default gains' PWM clamp, per compliant joint [N·m]."""
+    per_duty = np.abs(motor_table().torque_per_duty(battery_v))
+    return {name: float(per_duty[JOINT_INDEX[name]] * max_pwm)
+            for name, (_, _, max_pwm) in safe_default_gain_table().items() if max_pwm > 0}
+
+
+def gripping_torque_limits(torque_max_nm: Mapping[str, float], gripping_sides: set[str],
+                           strategy: str = DEFAULT_ARM_STRATEGY,
+                           battery_v: float = DEFAULT_BATTERY_V) -> dict[str, float]:
+    """Torque limits by joint [N·m] with the arms of ``gripping_sides`` ("left"/"right")
+    driven as ``strategy`` drives a gripping arm."""
+    if strategy not in ARM_STRATEGIES:
+        raise ValueError(f"unknown arm strategy {strategy!r}; use one of {ARM_STRATEGIES}")
+    limits = dict(torque_max_nm)
+    if strategy == "position":
+        return limits
+    compliant = compliant_torque_nm(battery_v)
+    for side in gripping_sides:
+        for name in ARM_JOINTS[side]:
+            if name in compliant and name in limits:
+                limits[name] = min(limits[name], compliant[name])
+    return limits
