@@ -16,7 +16,8 @@ ladder's orientation on a rung, level on the floor), then checks:
   holds, and a moving limb what it leaves in the first half of its segment and what it
   reaches in the second);
 - static stability with the holds in contact: the CoM inside the support region
-  (friction cones, Bretl–Lall) and the joint torques within limits (LP).
+  (friction cones, Bretl–Lall) and the joint torques within limits (LP), an arm whose
+  hand holds a rail limited to what the sidecar's arm strategy lets it give.
 
 It prints the worst line of each check and exits 0 when all pass, 1 when one fails,
 2 on bad input (the message names the file and the field or line).
@@ -201,6 +202,14 @@ class _Verifier:
         return self.data.oMf[self.frame_id[limb]].translation.copy()
 
     # ---------------------------------------------------------------- stability
+    def torque_limits(self, seg: Segment, arm_strategy: str) -> dict[str, float]:
+        """Torque limits [N·m] with the arms whose hands hold a rail in ``seg`` driven as
+        ``arm_strategy`` drives them (the planner's own capacity model: robot data)."""
+        from planner.arm_capacity import gripping_torque_limits
+
+        sides = {limb.split("_")[0] for limb in seg.holds if limb.endswith("hand")}
+        return gripping_torque_limits(self.torque_max, sides, arm_strategy)
+
     def contact_hold(self, limb: str, record) -> object:
         """The contact model of a recorded hold (sole corners on the tread, or a palm
         pushing up and pulling towards the ladder)."""
@@ -278,6 +287,9 @@ def check_plan(traj_rad: np.ndarray, sidecar: PlanSidecar, spec, robot: str | No
 
     robot = robot or sidecar.robot
     rate_hz = float(rate_hz or sidecar.rate_hz)
+    # The torque a gripping arm may carry depends on how it will be driven; a sidecar from
+    # before the strategy was recorded was planned with rigid arms.
+    arm_strategy = sidecar.metrics.get("arm_strategy", "position")
     n = len(traj_rad)
     if n != sidecar.line_count:
         raise InputError(f"{where}: the trajectory has {n} lines, its sidecar's field "
@@ -354,7 +366,8 @@ def check_plan(traj_rad: np.ndarray, sidecar: PlanSidecar, spec, robot: str | No
                 rep = v.collision.report(q)
                 clear, pair = rep.min_distance_m, " – ".join(rep.closest_pair)
             stance, region = v.stance(si, seg)
-            rep_s = check_stability(v.model, v.data, q, stance, region, v.torque_max)
+            rep_s = check_stability(v.model, v.data, q, stance, region,
+                                    v.torque_limits(seg, arm_strategy))
             tq = rep_s.torque
             out = (hit, clear, pair, rep_s.margin_m,
                    math.inf if tq is None else tq.max_ratio, "" if tq is None else tq.worst_joint,

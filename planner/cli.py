@@ -47,6 +47,10 @@ def _parser() -> argparse.ArgumentParser:
                         "highest rung the hands can hold rails above)")
     p.add_argument("--samples", type=int, default=50, metavar="N",
                    help="samples per step before backtracking (default 50)")
+    p.add_argument("--arm-strategy", default="mixed", choices=("mixed", "position"),
+                   help="how the arms will be driven while their hands hold rails, which sets "
+                        "the torque they can carry: mixed = PWM compliance (default), "
+                        "position = rigid")
     p.add_argument("--dwell", type=float, default=0.5, metavar="S",
                    help="quasi-static hold after each step [s] (default 0.5)")
     p.add_argument("--plots", metavar="DIR", help="write the CoM/support-region plot of "
@@ -109,7 +113,7 @@ def _plan(args: argparse.Namespace, err) -> int:
     t0 = time.perf_counter()
     spec = load_ladder(args.ladder)
     config = PlannerConfig(samples_per_step=args.samples, resolution_rad=args.resolution,
-                           time_limit_s=args.time_limit)
+                           time_limit_s=args.time_limit, arm_strategy=args.arm_strategy)
     planner = ClimbPlanner(spec, robot=args.robot, config=config, seed=args.seed)
     top = planner.top_rung() if args.top_rung is None else args.top_rung
     if not 0 <= top < spec.num_rungs:

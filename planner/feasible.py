@@ -72,9 +72,9 @@ TORQUE_DESCENT_PATIENCE = 150
 TORQUE_DESCENT_PELVIS_STEP_M = 0.04
 TORQUE_DESCENT_POSTURE_STEP_RAD = 0.1
 TORQUE_DESCENT_LEAN_STEP_RAD = 0.05
-#: The descent stops once the worst torque ratio is this low; a pose just under 1 leaves
-#: the path to its neighbours no room.
-TORQUE_DESCENT_TARGET_RATIO = 0.9
+#: The descent stops once the worst torque ratio is this share of the checker's bound; a
+#: pose just under the bound leaves the path to its neighbours no room.
+TORQUE_DESCENT_TARGET_SHARE = 0.9
 
 
 def _pitch(angle_rad: float) -> np.ndarray:
@@ -95,7 +95,7 @@ def _descend_torque(kin: HuboKinematics, checker: FeasibilityChecker, target: Se
     compliant arms takes a forward lean (the upper body's weight ahead of the hips
     unloads the bent knee) and arms that carry their load along their length (a 1.4 N·m
     wrist pitch): coordinated changes no single joint's preference makes. Returns the
-    first pose at or under `TORQUE_DESCENT_TARGET_RATIO`, else the best feasible one.
+    first pose at or under `TORQUE_DESCENT_TARGET_SHARE` of the bound, else the best feasible one.
     """
     # Around where the pelvis and joints are, not their targets: a target the holds keep
     # out of reach (e.g. over a foot on the rung while the other is still on the floor)
@@ -130,7 +130,7 @@ def _descend_torque(kin: HuboKinematics, checker: FeasibilityChecker, target: Se
         best_q, best_lean, stale = result.q, cand_lean, 0
         if verdict.ok:
             best_verdict = verdict
-            if best_ratio <= TORQUE_DESCENT_TARGET_RATIO:
+            if best_ratio <= TORQUE_DESCENT_TARGET_SHARE * checker.max_torque_ratio:
                 break
     if best_verdict is not None:
         return best_q, best_verdict

@@ -322,6 +322,7 @@ def write_plan(result: SearchResult, planner: ClimbPlanner, out_traj: str | os.P
         arm_modes[side] = arm_mode_runs(holding | (distances[side] <= PWM_RAIL_DISTANCE_M))
     metrics = _metrics(result, planner, timed, segments, clearance_every)
     metrics["palm_rail_pwm_distance_m"] = PWM_RAIL_DISTANCE_M
+    metrics["arm_strategy"] = planner.config.arm_strategy
     out_traj = Path(out_traj)
     write_trajectory(out_traj, timed.columns_rad)
     all_timings = dict(timings or {})

@@ -17,6 +17,7 @@ import pinocchio as pin
 
 from ladders.geometry import LadderGeometry
 from ladders.spec import LadderSpec
+from planner.arm_capacity import DEFAULT_ARM_STRATEGY
 from planner.collision import CollisionModel
 from planner.contacts import Hold, Stance
 from planner.feasible import FeasibleSearchStats, SearchTarget, find_feasible
@@ -62,6 +63,11 @@ class PlannerConfig:
     max_backtracks: int = 30
     time_limit_s: float = 600.0
     min_margin_m: float = 0.0
+    arm_strategy: str = DEFAULT_ARM_STRATEGY  # how gripping arms are driven (arm_capacity)
+    # Largest planned joint torque / limit. Below 1 because the load a position-controlled
+    # leg and a compliant arm really share differs from the LP's optimum (the split of a
+    # statically indeterminate load follows the joints' stiffness, not the LP).
+    max_torque_ratio: float = 1.0
 
 
 class PlanningFailed(HuboLadderError):
@@ -129,7 +135,8 @@ class ClimbPlanner:
         self.geom = LadderGeometry(spec)
         self.kin = HuboKinematics.load(robot)
         self.collision = CollisionModel(self.kin, ladder_collision_objects(spec))
-        self.checker = FeasibilityChecker(self.kin, self.collision, config.min_margin_m)
+        self.checker = FeasibilityChecker(self.kin, self.collision, config.min_margin_m,
+                                          config.arm_strategy, config.max_torque_ratio)
         self.config = config
         self.seed = seed
         self.rng = np.random.default_rng(seed)

@@ -28,6 +28,7 @@ import logging
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from functools import lru_cache
 
 import numpy as np
 from scipy.optimize import linprog
@@ -120,6 +121,15 @@ def friction_cone_edges(normals: np.ndarray, mu: np.ndarray | float, k: int = 8)
     tang = np.cos(ang)[None, :, None] * t1[:, None, :] + np.sin(ang)[None, :, None] * t2[:, None, :]
     edges = nrm[:, None, :] + mu_arr[:, None, None] * tang
     return edges / np.linalg.norm(edges, axis=2, keepdims=True)
+
+
+@lru_cache(maxsize=4096)
+def _cone_edges_cached(normals_bytes: bytes, mu: float, k: int) -> np.ndarray:
+    """`friction_cone_edges` of a hold's normals, memoised: the torque LP runs on every
+    interpolated configuration of a stance whose cones never change."""
+    edges = friction_cone_edges(np.frombuffer(normals_bytes).reshape(-1, 3), mu, k)
+    edges.setflags(write=False)
+    return edges
 
 
 # --------------------------------------------------------------------------------------
@@ -535,7 +545,8 @@ def torque_feasibility(model, data, q: np.ndarray, stance: Stance,
         t_inv = np.linalg.inv(hold.T_world_frame)
         pts_local = hold.points_m @ t_inv[:3, :3].T + t_inv[:3, 3]
         r = pts_local @ o_m_f.rotation.T  # world-frame offsets from the frame origin [m]
-        e = friction_cone_edges(hold.normals, hold.friction, cfg.cone_edges)  # (m, k, 3)
+        e = _cone_edges_cached(np.ascontiguousarray(hold.normals, dtype=float).tobytes(),
+                               float(hold.friction), cfg.cone_edges)  # (m, k, 3)
         k = e.shape[1]
         e_flat = e.reshape(-1, 3)
         wrench = np.vstack([e_flat.T, np.cross(np.repeat(r, k, axis=0), e_flat).T])  # (6, m k)

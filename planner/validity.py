@@ -47,10 +47,12 @@ class FeasibilityChecker:
     """Caches the support region per stance and checks configurations against it."""
 
     def __init__(self, kin: HuboKinematics, collision: CollisionModel,
-                 min_margin_m: float = 0.0, arm_strategy: str = DEFAULT_ARM_STRATEGY):
+                 min_margin_m: float = 0.0, arm_strategy: str = DEFAULT_ARM_STRATEGY,
+                 max_torque_ratio: float = 1.0):
         self.kin = kin
         self.collision = collision
         self.min_margin_m = min_margin_m
+        self.max_torque_ratio = max_torque_ratio
         self.arm_strategy = arm_strategy
         self.torque_max = torque_limits_by_joint(kin.params.name)
         self._torque_limits: dict[frozenset, dict[str, float]] = {}
@@ -107,7 +109,7 @@ class FeasibilityChecker:
                                  self.torque_limits(stance), min_margin_m=self.min_margin_m,
                                  frame_ids=self.frame_ids)
         ratio = report.torque.max_ratio if report.torque is not None else np.inf
-        if not report.stable:
+        if not report.stable or ratio > self.max_torque_ratio:
             why = (f"CoM {report.margin_m * 100:.1f} cm outside the support region"
                    if report.torque is None else
                    f"torque {ratio:.2f}× limit at {report.torque.worst_joint}")
