@@ -434,6 +434,52 @@ def torque_limits_by_joint(robot: str = "drc-hubo") -> dict[str, float]:
     return {n: float(t) for n, t in zip(JOINT_NAMES, lim, strict=True) if t > 0}
 
 
+_HIGHS = None
+
+
+def _solve_min_max_lp(cost: np.ndarray, a_ub: np.ndarray, b_ub: np.ndarray, a_eq: np.ndarray,
+                      b_eq: np.ndarray, upper: np.ndarray) -> tuple[str, np.ndarray | None]:
+    """min cost·x s.t. a_ub x ≤ b_ub, a_eq x = b_eq, 0 ≤ x ≤ upper, with HiGHS directly.
+
+    The torque LP runs on every interpolated configuration; scipy's ``linprog`` wrapper
+    costs more than HiGHS's solve of this small dense LP (≈ 2.8 against 1.5 ms). One
+    solver instance per process is reused; presolve is off (it only reformulates this
+    LP, and the optimum is the same).
+
+    Returns:
+        ``("optimal", x)``, ``("infeasible", None)`` or (HiGHS's status name, None).
+    """
+    import highspy
+
+    global _HIGHS
+    if _HIGHS is None:
+        _HIGHS = highspy.Highs()
+        _HIGHS.setOptionValue("output_flag", False)
+        _HIGHS.setOptionValue("presolve", "off")
+    inf = highspy.kHighsInf
+    a = np.vstack([a_ub, a_eq])
+    lp = highspy.HighsLp()
+    lp.num_col_, lp.num_row_ = a.shape[1], a.shape[0]
+    lp.col_cost_ = cost
+    lp.col_lower_ = np.zeros(a.shape[1])
+    lp.col_upper_ = np.where(np.isinf(upper), inf, upper)
+    lp.row_lower_ = np.concatenate([np.full(len(b_ub), -inf), b_eq])
+    lp.row_upper_ = np.concatenate([b_ub, b_eq])
+    lp.a_matrix_.format_ = highspy.MatrixFormat.kRowwise
+    rows, cols = np.nonzero(a)
+    lp.a_matrix_.start_ = np.concatenate([[0], np.cumsum(np.count_nonzero(a, axis=1))])
+    lp.a_matrix_.index_ = cols
+    lp.a_matrix_.value_ = a[rows, cols]
+    _HIGHS.passModel(lp)
+    _HIGHS.run()
+    status = _HIGHS.getModelStatus()
+    if status == highspy.HighsModelStatus.kOptimal:
+        return "optimal", np.array(_HIGHS.getSolution().col_value)
+    if status == highspy.HighsModelStatus.kInfeasible:
+        return "infeasible", None
+    return _HIGHS.modelStatusToString(status), None
+
+
 @dataclass(frozen=True, eq=False)
 class TorqueCheck:
     """Result of `torque_feasibility`.
@@ -563,21 +609,17 @@ def torque_feasibility(model, data, q: np.ndarray, stance: Stance,
     b_ub = np.concatenate([g_a, -g_a])
     a_eq = np.hstack([gmat[:6], np.zeros((6, 1))])
     b_eq = grav[:6]
-    bounds = np.zeros((n_lam + 1, 2))
-    bounds[:n_lam, 1] = cfg.force_max_weights
-    bounds[n_lam, 1] = np.inf
+    upper = np.full(n_lam + 1, cfg.force_max_weights)
+    upper[n_lam] = np.inf
     cost = np.zeros(n_lam + 1)
     cost[-1] = 1.0
-    # Presolve only reformulates this small dense LP: off, the solve is ~25 % faster (it
-    # runs on every interpolated configuration) and the optimum is the same.
-    res = linprog(cost, A_ub=a_ub, b_ub=b_ub, A_eq=a_eq, b_eq=b_eq, bounds=bounds,
-                  method="highs", options={"presolve": False})
-    if res.status == 2:
+    status, x = _solve_min_max_lp(cost, a_ub, b_ub, a_eq, b_eq, upper)
+    if status == "infeasible":
         return TorqueCheck(False, False, math.inf, "", joint_names=names)
-    if res.status != 0:
-        raise StabilityError(f"torque LP failed for {stance!r}: {res.message}")
+    if status != "optimal":
+        raise StabilityError(f"torque LP failed for {stance!r}: HiGHS status {status}")
 
-    lam = res.x[:n_lam]
+    lam = x[:n_lam]
     tau = (g_a - gm_a @ lam) * weight_n
     ratios = np.abs(tau) / tmax
     worst = int(np.argmax(ratios))

@@ -6,6 +6,7 @@ import importlib.metadata as md
 def test_all_dependencies_import_together():
     import can
     import coal
+    import highspy
     import matplotlib
     import mujoco
     import numpy
@@ -25,6 +26,8 @@ def test_all_dependencies_import_together():
     assert md.version("placo") == "0.10.2"
     assert md.version("ompl") == "2.0.1"
     assert md.version("toppra") == "0.6.10"
+    assert md.version("highspy") == "1.15.1"
+    assert highspy.Highs() is not None
     assert coal.Box(1, 1, 1) is not None
     assert ompl.base.RealVectorStateSpace(2).getDimension() == 2
     for mod in (can, matplotlib, numpy, placo, rich, scipy, toppra, trimesh, yaml, yourdfpy):
