@@ -141,18 +141,31 @@ def find_feasible(kin: HuboKinematics, checker: FeasibilityChecker, q_seed: np.n
                   target: SearchTarget, rng: np.random.Generator, *, attempts: int = 10,
                   posture_perturb_rad: float = 0.3, pelvis_perturb_m: float = 0.08,
                   retract_step_m: float = 0.04, ik_config: IKConfig | None = None,
-                  stats: FeasibleSearchStats | None = None
+                  stats: FeasibleSearchStats | None = None,
+                  q_hint: np.ndarray | None = None
                   ) -> tuple[np.ndarray | None, Verdict | None]:
     """A feasible configuration near ``q_seed`` for ``target``, or (None, last verdict).
 
-    The perturbation radius is 0 on the first attempt and grows linearly to the given
-    maxima on the last one.
+    A ``q_hint`` (e.g. the same stage solved on the rung below, moved up) is projected
+    onto the target first, its own posture preferred; if that is not feasible, the
+    perturbation radius is 0 on the first attempt and grows linearly to the given maxima
+    on the last one.
     """
     stats = stats or FeasibleSearchStats()
     ik_config = ik_config or IKConfig()
     region = checker.region(target.stability_stance)
     polygon = None if region.is_empty else region.clockwise_vertices()
     last: Verdict | None = None
+    if q_hint is not None:
+        stats.attempts += 1
+        result = solve_ik(kin, q_hint, target.support, target.moving,
+                          posture_rad=kin.posture(q_hint), pelvis_target_m=q_hint[:3].copy(),
+                          pelvis_weight=1.0, com_polygon_cw=polygon, preferences=False,
+                          config=ik_config)
+        if result.converged:
+            verdict = checker.check(result.q, target.stability_stance, target.contacts)
+            if verdict.ok:
+                return result.q, verdict
     for i in range(attempts):
         stats.attempts += 1
         scale = i / max(attempts - 1, 1)

@@ -144,6 +144,11 @@ class ClimbPlanner:
         self.away = -self.geom.R_world_ladder[:, 0]
         self.preferred_grip = preferred_grip_style(self.geom, self.kin.params)
         self.ik_config = IKConfig()
+        # Rungs repeat: a configuration found for a primitive's stage on one rung, moved
+        # by the rung-to-rung offset, is the first guess for the same stage on the next.
+        self._rung_step_m = self.geom.rung_top_point(1) - self.geom.rung_top_point(0) \
+            if spec.num_rungs > 1 else np.zeros(3)
+        self._found: dict[tuple[str, int], tuple[int, np.ndarray]] = {}
         self.ik_waypoint_config = IKConfig(
             moving_tol_m=self.ik_config.waypoint_tol_m,
             moving_angle_tol_rad=self.ik_config.waypoint_angle_tol_rad)
@@ -247,6 +252,19 @@ class ClimbPlanner:
                             pelvis_weight=weight, torso_R=self.torso_R,
                             retreat_direction=self.away)
 
+    def _hint(self, step: Step, stage: int, attempt: int) -> np.ndarray | None:
+        """The configuration found for ``step``'s primitive at ``stage`` on an earlier rung,
+        moved to this rung; only for a step's first sample (later ones explore)."""
+        found = self._found.get((step.primitive.name, stage))
+        if attempt > 0 or found is None or found[0] == step.rung:
+            return None
+        q = found[1].copy()
+        q[:3] += (step.rung - found[0]) * self._rung_step_m
+        return q
+
+    def _remember(self, step: Step, stage: int, q: np.ndarray) -> None:
+        self._found[(step.primitive.name, stage)] = (step.rung, q.copy())
+
     def _interp(self, qa, qb, support, stability, contacts, stats: StepStats, moving=()):
         istats = InterpolationStats()
         path = contact_space_interpolate(self.kin, self.checker, qa, qb, tuple(support),
@@ -296,9 +314,10 @@ class ClimbPlanner:
         else:
             q_lift, verdict = find_feasible(self.kin, self.checker, q, lift_target, self.rng,
                                             attempts=self.config.feasible_attempts,
-                                            stats=fstats)
+                                            stats=fstats, q_hint=self._hint(step, 0, attempt))
             if q_lift is None:
                 raise _StepRejected(f"no lift-off pose: {_why(verdict)}")
+            self._remember(step, 0, q_lift)
             path = self._interp(q, q_lift, stance.holds, stance, contacts_all, stats)
             segments.append(PathSegment(step, "body", stance.holds, (), path))
 
@@ -342,9 +361,11 @@ class ClimbPlanner:
             q_next, verdict = find_feasible(
                 self.kin, self.checker, q_cur, target, self.rng,
                 attempts=self.config.feasible_attempts, stats=fstats,
-                ik_config=self.ik_config if final else self.ik_waypoint_config)
+                ik_config=self.ik_config if final else self.ik_waypoint_config,
+                q_hint=self._hint(step, i, attempt))
             if q_next is None:
                 raise _StepRejected(f"way-point {i}/{n_way - 1}: {_why(verdict)}")
+            self._remember(step, i, q_next)
             limb_path += self._interp(q_cur, q_next, support, support_stance, contacts,
                                       stats, moving=targets)
             q_cur = q_next

@@ -170,9 +170,13 @@ def _toppra_trajectory(s: np.ndarray, columns: np.ndarray, v_max: np.ndarray,
     base[-1] = s[-1]
     steps = np.arange(subdivision) / subdivision
     grid = np.append((base[:-1, None] + np.diff(base)[:, None] * steps).ravel(), base[-1])
-    inst = algo.TOPPRA([constraint.JointVelocityConstraint(v_max),
-                        constraint.JointAccelerationConstraint(a_max)], path,
-                       gridpoints=grid, parametrizer="ParametrizeConstAccel")
+    try:
+        inst = algo.TOPPRA([constraint.JointVelocityConstraint(v_max),
+                            constraint.JointAccelerationConstraint(a_max)], path,
+                           gridpoints=grid, parametrizer="ParametrizeConstAccel")
+    except ValueError as exc:  # toppra refuses a grid it finds degenerate: try another
+        log.info("toppra refused the grid of a %d-knot path: %s", len(s), exc)
+        return None
     return inst.compute_trajectory(0, 0)
 
 

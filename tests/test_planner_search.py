@@ -1,5 +1,7 @@
 """The planner's search: IK projection, contact-space interpolation, determinism, failures."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -123,3 +125,40 @@ def test_unreachable_ladder_fails_with_the_primitive_and_rung():
         p.plan(top_rung=0)
     assert err.value.step.primitive.name == "placeHands"
     assert "rung 0" in str(err.value)
+
+
+def test_a_stage_solved_on_one_rung_is_the_first_guess_on_the_next(planner, standing):
+    step = climb_sequence(2)[7]  # moveRFoot onto rung 1
+    q, _ = standing
+    planner._remember(step, 2, q)
+    up = replace(step, rung=step.rung + 1)
+    hint = planner._hint(up, 2, attempt=0)
+    rung_step = planner.geom.rung_top_point(1) - planner.geom.rung_top_point(0)
+    np.testing.assert_allclose(hint[:3], q[:3] + rung_step)
+    np.testing.assert_array_equal(hint[3:], q[3:])
+    assert planner._hint(up, 2, attempt=1) is None  # later samples explore
+    assert planner._hint(step, 2, attempt=0) is None  # not on the rung it was found on
+    assert planner._hint(up, 3, attempt=0) is None  # nothing found for that stage
+
+
+def test_stepping_onto_rung_0_with_compliant_arms_is_found():
+    """The hardest step of the DRC mount: the right foot leaves the floor with the left on
+    rung 0 (0.305 m up) and PWM-compliant arms; the torque descent must find it."""
+    p = ClimbPlanner(load_ladder("drc"), seed=1)
+    assert p.config.arm_strategy == "mixed"
+    q, stance = p.start_configuration()
+    steps = climb_sequence(0)
+    for step in steps[:2]:
+        _, q, stance = p.try_step(step, q, stance, 0.0, StepStats("x"))
+    for attempt in range(10):
+        try:
+            _, q_end, new_stance = p.try_step(steps[2], q, stance, 0.0, StepStats("x"),
+                                              attempt)
+            break
+        except Exception:  # noqa: BLE001 - a failed sample; the search tries another
+            continue
+    else:
+        pytest.fail("placeRFoot not found in 10 samples")
+    verdict = p.checker.check(q_end, new_stance, {h.limb: h.target for h in new_stance.holds})
+    assert verdict.ok and verdict.torque_ratio <= 1.0
+    assert {h.target for h in new_stance.holds if not h.is_hand} == {"rung_0"}
