@@ -149,6 +149,7 @@ class ClimbPlanner:
         self._rung_step_m = self.geom.rung_top_point(1) - self.geom.rung_top_point(0) \
             if spec.num_rungs > 1 else np.zeros(3)
         self._found: dict[tuple[str, int], tuple[int, np.ndarray]] = {}
+        self._standing_pelvis_z_m = self.kin.params.pelvis_height_m  # set when standing
         self.ik_waypoint_config = IKConfig(
             moving_tol_m=self.ik_config.waypoint_tol_m,
             moving_angle_tol_rad=self.ik_config.waypoint_angle_tol_rad)
@@ -171,6 +172,7 @@ class ClimbPlanner:
         holds = tuple(make_hold(FloorSeed(limb), self.geom, kin.params, floor) for limb in floor)
         stance = Stance(holds)
         res = self._project(q, holds)
+        self._standing_pelvis_z_m = float(res[2])
         return res, stance
 
     def _project(self, q: np.ndarray, holds: tuple[Hold, ...]) -> np.ndarray:
@@ -229,7 +231,10 @@ class ClimbPlanner:
         """Seed pelvis position: the primitive's offset from the supporting feet."""
         feet = [h.T_world_frame[:3, 3] for h in support if not h.is_hand]
         offset = self.geom.R_world_ladder @ np.array(step.primitive.pelvis_offset_m)
-        return np.mean(feet, axis=0) + offset
+        target = np.mean(feet, axis=0) + offset
+        if step.primitive.pelvis_below_standing_m is not None:
+            target[2] = self._standing_pelvis_z_m - step.primitive.pelvis_below_standing_m
+        return target
 
     def _posture(self, step: Step, q: np.ndarray, support) -> dict[str, float]:
         """Seed posture: the primitive's, except that an arm holding a rail prefers where

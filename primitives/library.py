@@ -26,10 +26,10 @@ _HAND_PATH = LimbWaypoints(lift_m=0.0, clearance_m=0.10)
 PLACE_HANDS = Primitive("placeHands", ("left_hand", "right_hand"), {**_ARMS, **_STAND},
                         pelvis_offset_m=(-0.05, 0.0, 0.90), waypoints=_HAND_PATH)
 PLACE_L_FOOT = Primitive("placeLFoot", ("left_foot",), _ARMS)
-#: Stepping off the floor onto rung 0 (0.3 m up on the DRC ladder), the foot still on the
-#: floor keeps the pelvis low: seed it as high as that leg reaches, over the rung foot.
+#: Stepping off the floor onto rung 0, the foot still on the floor keeps the pelvis low:
+#: seed it about as high as that leg reaches (3 cm below standing), over the rung foot.
 PLACE_R_FOOT = Primitive("placeRFoot", ("right_foot",), _ARMS,
-                         pelvis_offset_m=(-0.05, 0.0, 0.62))
+                         pelvis_offset_m=(-0.05, 0.0, 0.0), pelvis_below_standing_m=0.03)
 MOVE_L_HAND = Primitive("moveLHand", ("left_hand",), {**_ARMS, **_STAND},
                         waypoints=_HAND_PATH)
 MOVE_R_HAND = Primitive("moveRHand", ("right_hand",), {**_ARMS, **_STAND},

@@ -40,6 +40,10 @@ class Primitive:
             one foot, this puts the pelvis over it with the stance leg nearly straight:
             a bent knee under the body's weight exceeds its 60 N·m.
         waypoints: the moving limb's way-point recipe.
+        pelvis_below_standing_m: when set, the seed pelvis height is this far below the
+            robot's standing height on the floor instead of ``pelvis_offset_m``'s height
+            above the supporting feet: while a foot is still on the floor, its leg bounds
+            how high the pelvis can rise, however high the other foot stands.
     """
 
     name: str
@@ -47,6 +51,7 @@ class Primitive:
     posture_rad: dict[str, float] = field(default_factory=dict)
     pelvis_offset_m: tuple[float, float, float] = (-0.1, 0.0, 0.88)
     waypoints: LimbWaypoints = LimbWaypoints()
+    pelvis_below_standing_m: float | None = None
 
 
 @dataclass(frozen=True)

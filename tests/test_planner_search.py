@@ -162,3 +162,17 @@ def test_stepping_onto_rung_0_with_compliant_arms_is_found():
     verdict = p.checker.check(q_end, new_stance, {h.limb: h.target for h in new_stance.holds})
     assert verdict.ok and verdict.torque_ratio <= 1.0
     assert {h.target for h in new_stance.holds if not h.is_hand} == {"rung_0"}
+
+
+def test_stepping_off_the_floor_seeds_the_pelvis_as_high_as_the_floor_leg_reaches(
+        planner, standing):
+    q, stance = standing
+    place_r_foot = climb_sequence(0)[2]
+    assert place_r_foot.primitive.name == "placeRFoot"
+    target = planner._pelvis_target(place_r_foot, stance.holds)
+    assert target[2] == pytest.approx(q[2] - place_r_foot.primitive.pelvis_below_standing_m)
+    # Other steps keep their height above the supporting feet.
+    straighten = climb_sequence(0)[3]
+    feet_z = np.mean([h.T_world_frame[2, 3] for h in stance.holds])
+    assert planner._pelvis_target(straighten, stance.holds)[2] == pytest.approx(
+        feet_z + straighten.primitive.pelvis_offset_m[2])
