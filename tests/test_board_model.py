@@ -13,13 +13,13 @@ sys.path.insert(0, str(Path(__file__).parent / "fixtures"))
 
 from daemon.board_model import BoardModel, BoardModelConfig  # noqa: E402
 from daemon.board_trip import BOARDS, BoardTripConfig, BoardTripMonitor  # noqa: E402
-from robot.motors import motor_table, pwm_torque  # noqa: E402
 from daemon.joint_control import ControlOutput, JointController  # noqa: E402
 from daemon.pwm import default_drc_gains  # noqa: E402
 from ladders.loader import load_ladder  # noqa: E402
 from robot.errors import InputError  # noqa: E402
 from robot.joints import JOINT_INDEX, NUM_JOINTS  # noqa: E402
 from robot.limits import joint_limits  # noqa: E402
+from robot.motors import motor_table, pwm_torque  # noqa: E402
 
 
 @pytest.fixture(scope="module")
