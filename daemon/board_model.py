@@ -46,7 +46,6 @@ import mujoco
 import numpy as np
 
 from daemon.board_trip import BOARDS, BoardTripConfig, BoardTripMonitor, TripEvent
-from robot.motors import DEFAULT_BATTERY_V, MotorTable, battery_power, motor_table
 from daemon.grasp_latch import GraspEvent, GraspLatch, GripConfig
 from daemon.joint_control import ControlOutput
 from daemon.sim_sensors import SensorIndex, SensorReading, add_sensors, read_sensors
@@ -55,6 +54,7 @@ from ladders.spec import LadderSpec
 from robot.errors import InputError
 from robot.joints import FINGER_JOINTS, JOINT_INDEX, JOINT_NAMES, NUM_JOINTS
 from robot.limits import joint_limits
+from robot.motors import DEFAULT_BATTERY_V, MotorTable, battery_power, motor_table
 from robot.params import robot_params
 
 __all__ = ["BoardModel", "BoardModelConfig", "BoardState", "PlacementError",

@@ -33,9 +33,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robot.motors import DEFAULT_BATTERY_V
 from ladders.spec import FIELD_RULES, LadderSpec
 from robot.errors import InputError
+from robot.motors import DEFAULT_BATTERY_V
 
 __all__ = ["PERTURB_KEYS", "Draw", "PerturbSpec", "draw", "parse_perturb"]
 
