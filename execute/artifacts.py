@@ -2,8 +2,8 @@
 
 - ``tracking_<arm>.png``: per arm joint, ``pos − ref`` [rad] against time, PWM stretches
   shaded (like thesis Figs. 4.3–4.4). Matplotlib with the Agg backend (no display).
-- ``snapshots.png``: a strip of frames from the scene's ``side`` camera, rendered
-  off-screen by ``mujoco.Renderer`` with ``MUJOCO_GL=egl``.
+- ``snapshots.png``: a strip of frames from the robot's right, following its CoM,
+  rendered off-screen by ``mujoco.Renderer`` with ``MUJOCO_GL=egl``.
 - ``*.mp4``: the same camera at 30 fps through imageio-ffmpeg.
 
 Rendering needs an OpenGL context. If EGL is not available (no GPU driver, no Mesa EGL),
@@ -28,6 +28,11 @@ log = logging.getLogger(__name__)
 SNAPSHOT_SIZE = (320, 240)  # [px] width, height of one strip frame
 VIDEO_SIZE = (640, 480)  # [px]
 VIDEO_FPS = 30
+#: Following camera: distance from the robot's CoM [m] and elevation [deg]. At MuJoCo's
+#: 45° field of view, 2.8 m shows a 2.3 m tall slice: the 1.45 m robot, its holds and
+#: the rungs around them.
+FOLLOW_DISTANCE_M = 2.8
+FOLLOW_ELEVATION_DEG = -10.0
 
 
 class RenderingUnavailable(RuntimeError):
@@ -71,7 +76,9 @@ def write_tracking_plots(run, out_dir: str | os.PathLike) -> list[Path]:
 
 
 def render_frames(run, times_s, size: tuple[int, int]) -> list[np.ndarray]:
-    """RGB frames of the ``side`` camera at the given simulated times.
+    """RGB frames at the given simulated times, seen from the robot's right like the
+    scene's ``side`` camera but following the robot at `FOLLOW_DISTANCE_M` from its CoM
+    (the fixed camera frames the whole ladder, which leaves the robot small).
 
     Raises:
         RenderingUnavailable: no EGL context (message says how to get one).
@@ -97,13 +104,19 @@ def render_frames(run, times_s, size: tuple[int, int]) -> list[np.ndarray]:
                                    f"MUJOCO_GL={gl!r} ({exc}); {hint}") from None
     option = mujoco.MjvOption()
     option.geomgroup[:] = 1  # the robot's geoms are in group 3 (collision class)
+    camera = mujoco.MjvCamera()
+    camera.type = mujoco.mjtCamera.mjCAMERA_FREE
+    camera.azimuth, camera.elevation = 90.0, FOLLOW_ELEVATION_DEG  # from −y, looking +y
+    camera.distance = FOLLOW_DISTANCE_M
+    pelvis = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "pelvis")
     frames = []
     try:
         for t in times_s:
             k = int(np.clip(np.searchsorted(lg.time_s, t), 0, len(lg.time_s) - 1))
             d.qpos[:] = lg.qpos[k]
             mujoco.mj_forward(m, d)
-            renderer.update_scene(d, camera="side", scene_option=option)
+            camera.lookat[:] = d.subtree_com[pelvis]
+            renderer.update_scene(d, camera=camera, scene_option=option)
             frames.append(renderer.render().copy())
     finally:
         renderer.close()
