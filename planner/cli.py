@@ -178,6 +178,10 @@ def main(argv: list[str] | None = None) -> int:
     level = (logging.WARNING, logging.INFO, logging.DEBUG)[min(args.verbose, 2)]
     logging.basicConfig(level=level, format="%(name)s: %(message)s",
                         handlers=[RichHandler(console=err, show_time=False)], force=True)
+    if args.verbose == 0:
+        # toppra warns about every path its LP solver finds numerically uncontrollable;
+        # planner.timing retries and falls back on those and logs that itself (at INFO).
+        logging.getLogger("toppra").setLevel(logging.ERROR)
     try:
         _check_args(args)
         return _plan(args, err)
