@@ -20,7 +20,6 @@ from daemon.joint_control import (
     default_compliance_capable,
 )
 from daemon.pwm import (
-    DRC_DOCUMENTED_GAINS,
     PwmGainError,
     PwmGains,
     default_drc_gains,
@@ -30,7 +29,6 @@ from daemon.pwm import (
 
 __all__ = [
     "DAEMON_RATE_HZ",
-    "DRC_DOCUMENTED_GAINS",
     "TICK_S",
     "ComplianceState",
     "ControlInputError",

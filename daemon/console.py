@@ -30,13 +30,12 @@ Exit codes: 0 every command done, 1 the daemon did not answer, 2 a command was r
 from __future__ import annotations
 
 import argparse
-import math
 import sys
 import time
 
 import numpy as np
 
-from robot.errors import HuboLadderError, InputError
+from robot.errors import HuboLadderError, InputError, parse_finite
 
 __all__ = ["Console", "main"]
 
@@ -54,16 +53,6 @@ def _joint(token: str) -> int:
         return int(token)
     raise InputError(f"unknown joint {token!r}; valid: 0..{NUM_JOINTS - 1} or "
                      f"{' '.join(JOINT_NAMES)}")
-
-
-def _number(token: str, what: str) -> float:
-    try:
-        v = float(token)
-    except ValueError:
-        v = math.nan
-    if not math.isfinite(v):
-        raise InputError(f"{what} {token!r} is not a finite number")
-    return v
 
 
 def format_joint(s: np.ndarray, j: int) -> str:
@@ -175,13 +164,13 @@ class Console:
             self.board_command(T.HOME, j)
         elif cmd in ("goto", "comp"):
             j = _joint(rest[0])
-            self.reference(j, _number(rest[1], "position"), cmd == "comp")
+            self.reference(j, parse_finite(rest[1], "position"), cmd == "comp")
         elif cmd in _GAIN_COMMANDS:
             from robot.joints import JOINT_NAMES
 
             j = _joint(rest[0])
             field, bit = _GAIN_COMMANDS[cmd]
-            v = _number(rest[1], words[0])
+            v = parse_finite(rest[1], words[0])
             limit = GAIN_LIMITS[field]
             if not limit.contains(np.array([v]))[0]:
                 raise InputError(f"{words[0]} {v:g} for {JOINT_NAMES[j]} refused: allowed "

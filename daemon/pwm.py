@@ -42,26 +42,16 @@ import numpy as np
 from robot.errors import InputError
 from robot.joints import JOINT_INDEX, JOINT_NAMES, NUM_JOINTS
 from robot.pwm_gains import (
-    DRC_DOCUMENTED_GAINS,
     KD_LIMIT,
     KP_LIMIT,
     MAX_PWM_LIMIT_PCT,
     PWM_COMMAND_LIMIT_PCT,
-    SAFE_KP,
-    SAFE_MAX_PWM_PCT,
     safe_default_gain_table,
 )
 
 __all__ = [
-    "DRC_DOCUMENTED_GAINS",
     "GAIN_LIMITS",
     "GainLimit",
-    "KD_LIMIT",
-    "KP_LIMIT",
-    "MAX_PWM_LIMIT_PCT",
-    "PWM_COMMAND_LIMIT_PCT",
-    "SAFE_KP",
-    "SAFE_MAX_PWM_PCT",
     "PwmGainError",
     "PwmGains",
     "default_drc_gains",

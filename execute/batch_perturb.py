@@ -34,7 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ladders.spec import FIELD_RULES, LadderSpec
-from robot.errors import InputError
+from robot.errors import InputError, parse_finite
 from robot.motors import DEFAULT_BATTERY_V
 
 __all__ = ["PERTURB_KEYS", "Draw", "PerturbSpec", "draw", "parse_perturb"]
@@ -86,16 +86,6 @@ class PerturbSpec:
                              f"{rule.describe()}")
 
 
-def _number(key: str, text: str) -> float:
-    try:
-        v = float(text)
-    except ValueError:
-        v = math.nan
-    if not math.isfinite(v):
-        raise InputError(f"--perturb {key}={text!r}: not a number")
-    return v
-
-
 def parse_perturb(text: str | None) -> PerturbSpec:
     """Parse ``key=value[,key=lo:hi...]`` (see the module docstring).
 
@@ -120,15 +110,15 @@ def parse_perturb(text: str | None) -> PerturbSpec:
         kind, low, high, unit = PERTURB_KEYS[key]
         u = f" {unit}" if unit else ""
         if kind == "half-width":
-            v = _number(key, val)
+            v = parse_finite(val, f"--perturb {key}:")
             if not 0.0 < v <= high:
                 raise InputError(f"--perturb {key}={val}: allowed (0, {high:.4g}]{u} "
                                  "(a half-width: draws are uniform in ±value)")
             values[key] = v
         else:
             lo_s, colon, hi_s = val.partition(":")
-            lo = _number(key, lo_s)
-            hi = _number(key, hi_s) if colon else lo
+            lo = parse_finite(lo_s, f"--perturb {key}:")
+            hi = parse_finite(hi_s, f"--perturb {key}:") if colon else lo
             if not low <= lo <= hi <= high:
                 raise InputError(f"--perturb {key}={val}: expected lo:hi (or one value) with "
                                  f"{low:g} ≤ lo ≤ hi ≤ {high:g}{u}")

@@ -33,7 +33,7 @@ from typing import Any
 import numpy as np
 import yaml
 
-from ladders.loader import YamlProblems, load_ladder, mapping_items
+from ladders.loader import YamlProblems, document_items, load_ladder, mapping_items
 from ladders.spec import FIELD_RULES, LadderFieldError, LadderSpec, check_field
 from robot.errors import InputError, LadderSpecError
 
@@ -152,19 +152,7 @@ def parse_sweep_yaml(text: str, source: str = "<string>",
         InputError: ``SOURCE:LINE: ...`` naming the field and the allowed values.
     """
     problems = YamlProblems(source, InputError)
-    try:
-        root = yaml.compose(text, Loader=yaml.SafeLoader)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        line = mark.line + 1 if mark is not None else 1
-        raise InputError(f"{source}:{line}: YAML syntax error: "
-                         f"{getattr(exc, 'problem', None) or exc}") from None
-    if root is None:
-        raise InputError(f"{source}:1: the file is empty; expected keys "
-                         f"{', '.join(_TOP_KEYS)}")
-    top = mapping_items(root, "the document", problems)
-    problems.raise_if_any()
-    assert top is not None
+    root, top = document_items(text, problems, f"keys {', '.join(_TOP_KEYS)}")
     for key, (knode, _) in top.items():
         if key not in _TOP_KEYS:
             problems.add(knode, f"field '{key}' is unknown; valid keys: {', '.join(_TOP_KEYS)}")

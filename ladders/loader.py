@@ -117,6 +117,30 @@ def _unknown_key_message(path: str, valid: list[str]) -> str:
     return f"field '{path}' is unknown; valid keys here: {', '.join(valid)}"
 
 
+def document_items(text: str, problems: YamlProblems, expected: str
+                   ) -> tuple[yaml.Node, dict[str, tuple[yaml.Node, yaml.Node]]]:
+    """A YAML document's root node and its top-level ``{key: (key node, value node)}``.
+
+    Raises:
+        ``problems.error``: ``SOURCE:LINE: ...`` for a syntax error, an empty document
+            (the message says it ``expected`` ...) or a document that is not a mapping.
+    """
+    source = problems.source
+    try:
+        root = yaml.compose(text, Loader=yaml.SafeLoader)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        line = mark.line + 1 if mark is not None else 1
+        reason = getattr(exc, "problem", None) or str(exc).splitlines()[0]
+        raise problems.error(f"{source}:{line}: YAML syntax error: {reason}") from None
+    if root is None:
+        raise problems.error(f"{source}:1: the file is empty; expected {expected}")
+    top = mapping_items(root, "the document", problems)
+    problems.raise_if_any()
+    assert top is not None
+    return root, top
+
+
 def parse_ladder_yaml(text: str, source: str = "<string>") -> LadderSpec:
     """Parse and validate the text of a ladder spec file.
 
@@ -133,19 +157,8 @@ def parse_ladder_yaml(text: str, source: str = "<string>") -> LadderSpec:
             and cross-field rule violations.
     """
     problems = YamlProblems(source)
-    try:
-        root = yaml.compose(text, Loader=yaml.SafeLoader)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        line = mark.line + 1 if mark is not None else 1
-        reason = getattr(exc, "problem", None) or str(exc).splitlines()[0]
-        raise LadderSpecError(f"{source}:{line}: YAML syntax error: {reason}") from None
-    if root is None:
-        raise LadderSpecError(f"{source}:1: the file is empty; expected a ladder spec mapping "
-                              f"with sections {', '.join(s for s in LAYOUT if s)}")
-    top = mapping_items(root, "the document", problems)
-    problems.raise_if_any()
-    assert top is not None
+    root, top = document_items(text, problems, "a ladder spec mapping with sections "
+                               + ", ".join(s for s in LAYOUT if s))
     values: dict[str, Any] = {}
     nodes: dict[str, yaml.Node] = {}
     valid_top = [k for k in LAYOUT[None]] + [s for s in LAYOUT if s]

@@ -17,7 +17,9 @@ not have: the legs then saturate and their boards trip (validate-plan shows it).
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
+from functools import lru_cache
+from types import MappingProxyType
 
 import numpy as np
 
@@ -26,31 +28,38 @@ from robot.motors import DEFAULT_BATTERY_V, motor_table
 from robot.pwm_gains import safe_default_gain_table
 
 __all__ = ["ARM_STRATEGIES", "DEFAULT_ARM_STRATEGY", "compliant_torque_nm",
-           "gripping_torque_limits"]
+           "gripping_sides", "gripping_torque_limits"]
 
 ARM_STRATEGIES = ("mixed", "position")
 DEFAULT_ARM_STRATEGY = "mixed"
 
 
-def compliant_torque_nm(battery_v: float = DEFAULT_BATTERY_V) -> dict[str, float]:
+@lru_cache(maxsize=16)
+def compliant_torque_nm(battery_v: float = DEFAULT_BATTERY_V) -> Mapping[str, float]:
     """Stall torque at the default gains' PWM clamp, per compliant joint [N·m]."""
     per_duty = np.abs(motor_table().torque_per_duty(battery_v))
-    return {name: float(per_duty[JOINT_INDEX[name]] * max_pwm)
-            for name, (_, _, max_pwm) in safe_default_gain_table().items() if max_pwm > 0}
+    return MappingProxyType({
+        name: float(per_duty[JOINT_INDEX[name]] * max_pwm)
+        for name, (_, _, max_pwm) in safe_default_gain_table().items() if max_pwm > 0})
 
 
-def gripping_torque_limits(torque_max_nm: Mapping[str, float], gripping_sides: set[str],
+def gripping_sides(limbs: Iterable[str]) -> frozenset[str]:
+    """The arms ("left"/"right") whose hands are among ``limbs`` (limb names)."""
+    return frozenset(limb.removesuffix("_hand") for limb in limbs if limb.endswith("_hand"))
+
+
+def gripping_torque_limits(torque_max_nm: Mapping[str, float], sides: Iterable[str],
                            strategy: str = DEFAULT_ARM_STRATEGY,
                            battery_v: float = DEFAULT_BATTERY_V) -> dict[str, float]:
-    """Torque limits by joint [N·m] with the arms of ``gripping_sides`` ("left"/"right")
-    driven as ``strategy`` drives a gripping arm."""
+    """Torque limits by joint [N·m] with the arms of ``sides`` ("left"/"right") driven as
+    ``strategy`` drives a gripping arm."""
     if strategy not in ARM_STRATEGIES:
         raise ValueError(f"unknown arm strategy {strategy!r}; use one of {ARM_STRATEGIES}")
     limits = dict(torque_max_nm)
     if strategy == "position":
         return limits
     compliant = compliant_torque_nm(battery_v)
-    for side in gripping_sides:
+    for side in sides:
         for name in ARM_JOINTS[side]:
             if name in compliant and name in limits:
                 limits[name] = min(limits[name], compliant[name])

@@ -122,7 +122,7 @@ def allowed_contacts(segments: Sequence[Segment], index: int, fraction: float
 class _Verifier:
     """The robot and ladder models the checks run on."""
 
-    def __init__(self, spec, robot: str):
+    def __init__(self, spec, robot: str, arm_strategy: str):
         import pinocchio as pin
 
         from ladders.collision import ladder_collision_objects
@@ -146,7 +146,8 @@ class _Verifier:
         robot_view = SimpleNamespace(model=self.model, data=self.data, params=self.params)
         self.collision = CollisionModel(robot_view, ladder_collision_objects(spec))
         self.torque_max = torque_limits_by_joint(self.params.name)
-        self._regions: dict[int, tuple] = {}
+        self.arm_strategy = arm_strategy
+        self._stances: dict[int, tuple] = {}  # segment index → stance, region, limits
 
     # ---------------------------------------------------------------- configuration
     def sole_rotation(self, target: str) -> np.ndarray:
@@ -202,14 +203,6 @@ class _Verifier:
         return self.data.oMf[self.frame_id[limb]].translation.copy()
 
     # ---------------------------------------------------------------- stability
-    def torque_limits(self, seg: Segment, arm_strategy: str) -> dict[str, float]:
-        """Torque limits [N·m] with the arms whose hands hold a rail in ``seg`` driven as
-        ``arm_strategy`` drives them (the planner's own capacity model: robot data)."""
-        from planner.arm_capacity import gripping_torque_limits
-
-        sides = {limb.split("_")[0] for limb in seg.holds if limb.endswith("hand")}
-        return gripping_torque_limits(self.torque_max, sides, arm_strategy)
-
     def contact_hold(self, limb: str, record) -> object:
         """The contact model of a recorded hold (sole corners on the tread, or a palm
         pushing up and pulling towards the ladder)."""
@@ -238,15 +231,21 @@ class _Verifier:
         return Hold(limb, record.target, T, local @ R.T + p, np.tile(up, (4, 1)), mu)
 
     def stance(self, seg_index: int, seg: Segment):
-        """The stance of a segment and its support region, cached."""
-        if seg_index not in self._regions:
+        """The stance of a segment, its support region and its joint torque limits [N·m]
+        (arms whose hands hold a rail driven as the plan's arm strategy drives them; the
+        planner's capacity model is robot data), cached."""
+        if seg_index not in self._stances:
+            from planner.arm_capacity import gripping_sides, gripping_torque_limits
             from planner.contacts import Stance
             from planner.stability import support_region
 
             stance = Stance(tuple(self.contact_hold(lb, h) for lb, h in sorted(seg.holds.items())))
-            self._regions[seg_index] = (stance, support_region(stance,
-                                                               self.params.total_mass_kg))
-        return self._regions[seg_index]
+            limits = gripping_torque_limits(self.torque_max, gripping_sides(seg.holds),
+                                            self.arm_strategy)
+            self._stances[seg_index] = (stance, support_region(stance,
+                                                               self.params.total_mass_kg),
+                                        limits)
+        return self._stances[seg_index]
 
 
 def _segment_of_lines(sidecar: PlanSidecar, where: str) -> np.ndarray:
@@ -296,7 +295,7 @@ def check_plan(traj_rad: np.ndarray, sidecar: PlanSidecar, spec, robot: str | No
                          f"'line_count' says {sidecar.line_count}")
     seg_of = _segment_of_lines(sidecar, where)
     segs = sidecar.segments
-    v = _Verifier(spec, robot)
+    v = _Verifier(spec, robot, arm_strategy)
     lim = joint_limits(robot)
     res = {c: CheckResult(c) for c in CHECKS}
     res["joint limits"].limit, res["joint limits"].unit = 0.0, "rad past limit"
@@ -365,9 +364,8 @@ def check_plan(traj_rad: np.ndarray, sidecar: PlanSidecar, spec, robot: str | No
             if hit or (line - 1) % CLEARANCE_EVERY_LINES == 0:
                 rep = v.collision.report(q)
                 clear, pair = rep.min_distance_m, " – ".join(rep.closest_pair)
-            stance, region = v.stance(si, seg)
-            rep_s = check_stability(v.model, v.data, q, stance, region,
-                                    v.torque_limits(seg, arm_strategy))
+            stance, region, torque_limits = v.stance(si, seg)
+            rep_s = check_stability(v.model, v.data, q, stance, region, torque_limits)
             tq = rep_s.torque
             out = (hit, clear, pair, rep_s.margin_m,
                    math.inf if tq is None else tq.max_ratio, "" if tq is None else tq.worst_joint,

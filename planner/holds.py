@@ -53,10 +53,11 @@ def palm_rotation(geom: LadderGeometry, side: str, grip_m: np.ndarray | None = N
     raise AssertionError("unreachable: one of the two grip-axis signs is outboard")
 
 
-def hand_retreat_direction(hold: Hold) -> np.ndarray:
-    """Unit vector along which a hand leaves its rail: away from its open side."""
-    s = 1.0 if hold.limb == "left_hand" else -1.0
-    return -s * hold.T_world_frame[:3, 1]
+def hand_retreat_direction(limb: str, T_world_palm: np.ndarray) -> np.ndarray:
+    """Unit vector along which a hand at ``T_world_palm`` leaves (or approaches) its rail:
+    away from its open side (s·y_palm, s = +1 left, −1 right)."""
+    s = 1.0 if limb == "left_hand" else -1.0
+    return -s * T_world_palm[:3, 1]
 
 
 def rail_point(geom: LadderGeometry, side: str, rung: int, along_m: float = 0.0) -> np.ndarray:

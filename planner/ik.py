@@ -79,8 +79,7 @@ def solve_ik(kin: HuboKinematics, q_seed: np.ndarray, support: tuple[Hold, ...],
              moving: tuple[Hold, ...] = (), *, posture_rad: dict[str, float] | None = None,
              torso_R: np.ndarray | None = None, pelvis_target_m: np.ndarray | None = None,
              pelvis_weight: float = 0.0, com_polygon_cw: np.ndarray | None = None,
-             preferences: bool = True, torso_lean: bool = False,
-             config: IKConfig = IKConfig()) -> IKResult:
+             preferences: bool = True, config: IKConfig = IKConfig()) -> IKResult:
     """Project ``q_seed`` onto the holds and pull the moving limbs to their targets.
 
     Args:
@@ -94,8 +93,6 @@ def solve_ik(kin: HuboKinematics, q_seed: np.ndarray, support: tuple[Hold, ...],
         com_polygon_cw: clockwise CoM polygon (k, 2) to stay inside, with margin.
         preferences: add soft preferences of the holds (hand open side towards the
             ladder). Off for projections, where only the posture task may pull.
-        torso_lean: keep only the lateral axes of torso and pelvis along ``torso_R``'s,
-            so they may pitch (lean towards the ladder) but neither twist nor roll.
 
     Returns:
         The result; ``converged`` means every hold and target is met within tolerance.
@@ -126,11 +123,7 @@ def solve_ik(kin: HuboKinematics, q_seed: np.ndarray, support: tuple[Hold, ...],
         # Torso and pelvis both face the ladder: otherwise waist and hip yaws trade off
         # freely and neighbouring IK solutions twist the pelvis by tens of degrees.
         for frame in ("torso_frame", "pelvis"):
-            if torso_lean:
-                ot = solver.add_axisalign_task(frame, np.array([0.0, 1.0, 0.0]),
-                                               np.asarray(torso_R)[:, 1].copy())
-            else:
-                ot = solver.add_orientation_task(frame, torso_R)
+            ot = solver.add_orientation_task(frame, torso_R)
             ot.configure(f"{frame}_upright", "soft", config.torso_upright_weight)
     if pelvis_target_m is not None and pelvis_weight > 0:
         pt = solver.add_position_task("pelvis", np.asarray(pelvis_target_m, dtype=float))

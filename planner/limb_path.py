@@ -33,13 +33,13 @@ def hand_waypoints(T_from: np.ndarray, target: Hold, geom: LadderGeometry,
 
     ``on_rail`` says whether the hand starts closed on a rail (it then backs off first).
     """
-    away = hand_retreat_direction(target) * recipe.clearance_m
+    away = hand_retreat_direction(target.limb, target.T_world_frame) * recipe.clearance_m
     T_to = target.T_world_frame
     T_pre = _shifted(T_to, away)
     points = [T_from]
     if on_rail:
-        s = 1.0 if target.limb == "left_hand" else -1.0
-        points.append(_shifted(T_from, -s * T_from[:3, 1] * recipe.clearance_m))
+        back = hand_retreat_direction(target.limb, T_from) * recipe.clearance_m
+        points.append(_shifted(T_from, back))
     else:
         # From the floor the hand rises inside the rail, then moves out to it: a straight
         # line from the hanging pose would sweep past the rail's lower end.

@@ -64,9 +64,9 @@ class PlannerConfig:
     time_limit_s: float = 600.0
     min_margin_m: float = 0.0
     arm_strategy: str = DEFAULT_ARM_STRATEGY  # how gripping arms are driven (arm_capacity)
-    # Largest planned joint torque / limit. Below 1 because the load a position-controlled
-    # leg and a compliant arm really share differs from the LP's optimum (the split of a
-    # statically indeterminate load follows the joints' stiffness, not the LP).
+    # Largest planned joint torque / limit. A bound below 1 would leave room for the load
+    # a position-controlled leg and a compliant arm really share differing from the LP's
+    # optimum; at 0.85 the DRC mount has no solution, so the default is the limit itself.
     max_torque_ratio: float = 1.0
 
 

@@ -318,6 +318,13 @@ def _limit_positions(lines: np.ndarray, limits: JointLimits) -> np.ndarray:
     return out
 
 
+def _knot_indices(length_rad: float, n_points: int, spacing_rad: float) -> np.ndarray:
+    """Indices of evenly spread knots about ``spacing_rad`` of path apart (at least 4,
+    at most every point) among ``n_points`` dense path points."""
+    n_knots = int(min(n_points, max(4, math.ceil(length_rad / spacing_rad) + 1)))
+    return np.unique(np.round(np.linspace(0, n_points - 1, n_knots)).astype(int))
+
+
 def _time_segment(seg: SegmentPath, limits: JointLimits, cfg: TimingConfig
                   ) -> tuple[np.ndarray, np.ndarray | None, float] | None:
     """Sampled lines of one segment (its start point first), their configurations and
@@ -339,8 +346,7 @@ def _time_segment(seg: SegmentPath, limits: JointLimits, cfg: TimingConfig
         # path is smooth, so the spline strays from the dropped points by little; a
         # coarser or finer grid is tried when toppra still fails.
         for spacing in KNOT_SPACING_RAD * np.array([1.0, 0.8, 2.0, 0.6, 1.4, 4.0, 0.4]):
-            n_knots = int(min(len(way), max(4, math.ceil(s_all[-1] / spacing) + 1)))
-            idx = np.unique(np.round(np.linspace(0, len(way) - 1, n_knots)).astype(int))
+            idx = _knot_indices(s_all[-1], len(way), spacing)
             for grid_sub in (sub, 1, 3):
                 traj = _toppra_trajectory(s_all[idx], way[idx],
                                           scale * limits.velocity_nominal_rad_s,
@@ -352,8 +358,7 @@ def _time_segment(seg: SegmentPath, limits: JointLimits, cfg: TimingConfig
         if traj is None:
             log.info("%s: toppra found no parameterisation; timing it with a conservative "
                      "trapezoid", seg.label)
-            n_knots = int(min(len(way), max(4, math.ceil(s_all[-1] / KNOT_SPACING_RAD) + 1)))
-            idx = np.unique(np.round(np.linspace(0, len(way) - 1, n_knots)).astype(int))
+            idx = _knot_indices(s_all[-1], len(way), KNOT_SPACING_RAD)
             traj = _TrapezoidTrajectory(s_all[idx], way[idx],
                                         scale * limits.velocity_nominal_rad_s,
                                         scale * limits.accel_nominal_rad_s2)

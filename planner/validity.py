@@ -13,7 +13,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planner.arm_capacity import DEFAULT_ARM_STRATEGY, gripping_torque_limits
+from planner.arm_capacity import (
+    DEFAULT_ARM_STRATEGY,
+    gripping_sides,
+    gripping_torque_limits,
+)
 from planner.collision import CollisionModel
 from planner.contacts import Stance
 from planner.kinematics import HuboKinematics
@@ -76,10 +80,10 @@ class FeasibilityChecker:
 
     def torque_limits(self, stance: Stance) -> dict[str, float]:
         """Torque limit per joint [N·m] while ``stance`` carries the robot."""
-        sides = frozenset(h.limb.split("_")[0] for h in stance.holds if h.is_hand)
+        sides = gripping_sides(h.limb for h in stance.holds)
         if sides not in self._torque_limits:
             self._torque_limits[sides] = gripping_torque_limits(
-                self.torque_max, set(sides), self.arm_strategy)
+                self.torque_max, sides, self.arm_strategy)
         return self._torque_limits[sides]
 
     def check(self, q: np.ndarray, stance: Stance, contacts: dict[str, str]) -> Verdict:

@@ -7,6 +7,7 @@ line, column or field and the allowed range.
 
 from __future__ import annotations
 
+import math
 import sys
 from collections.abc import Callable
 
@@ -32,6 +33,17 @@ class TrajectoryFileError(InputError):
 
 class LadderSpecError(InputError):
     """A ladder spec failed validation."""
+
+
+def parse_finite(text: str, what: str) -> float:
+    """``text`` as a finite float, or an `InputError` naming ``what`` it was meant to be."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not math.isfinite(value):
+        raise InputError(f"{what} {text!r} is not a number (finite numbers only)")
+    return value
 
 
 class RobotModelError(HuboLadderError):

@@ -6,10 +6,6 @@ import numpy as np
 import pytest
 
 from daemon.pwm import (
-    DRC_DOCUMENTED_GAINS,
-    KD_LIMIT,
-    KP_LIMIT,
-    MAX_PWM_LIMIT_PCT,
     PwmGainError,
     PwmGains,
     default_drc_gains,
@@ -19,6 +15,7 @@ from daemon.pwm import (
 )
 from robot.errors import InputError
 from robot.joints import JOINT_INDEX, JOINT_NAMES
+from robot.pwm_gains import DRC_DOCUMENTED_GAINS, KD_LIMIT, KP_LIMIT, MAX_PWM_LIMIT_PCT
 
 N = 40
 J = JOINT_INDEX
