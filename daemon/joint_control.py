@@ -59,6 +59,7 @@ from daemon.control_modes import (
 from daemon.pwm import PwmGains, pwm_duty
 from robot.errors import InputError
 from robot.joints import ARM_JOINTS, FINGER_JOINTS, JOINT_INDEX, JOINT_NAMES, NUM_JOINTS
+from robot.pwm_gains import PWM_COMMAND_LIMIT_PCT
 from robot.limits import JointLimits, joint_limits
 
 __all__ = [
@@ -206,6 +207,7 @@ class JointController:
         pos_rad: np.ndarray,
         vel_rad_s: np.ndarray,
         gains: PwmGains,
+        pwm_command_pct: np.ndarray | None = None,
     ) -> ControlOutput:
         """Runs one 5 ms tick of the control law.
 
@@ -216,6 +218,9 @@ class JointController:
             pos_rad: measured position [rad], shape (40,).
             vel_rad_s: measured velocity [rad/s], shape (40,).
             gains: validated PWM gains.
+            pwm_command_pct: this tick's feed-forward duty [%], shape (40,), within
+                ``±PWM_COMMAND_LIMIT_PCT``, replacing ``gains.pwm_command_pct`` (the
+                player's per-line feed-forward); None keeps the gains'.
 
         Returns:
             The references, duties and flags to send this tick.
@@ -229,6 +234,13 @@ class JointController:
         comply = _vector("comply_mask", comply_mask, bool)
         pos = _vector("pos_rad", pos_rad)
         vel = _vector("vel_rad_s", vel_rad_s)
+        if pwm_command_pct is not None:
+            pwm_command_pct = _vector("pwm_command_pct", pwm_command_pct)
+            bad = np.abs(pwm_command_pct) > PWM_COMMAND_LIMIT_PCT
+            if bad.any():
+                names = ", ".join(JOINT_NAMES[i] for i in np.flatnonzero(bad))
+                raise ControlInputError(f"pwm_command_pct of {names} is outside "
+                                        f"±{PWM_COMMAND_LIMIT_PCT:g} %")
         if self._sent_rad is None:
             self.reset(pos)
         lower, upper = self.limits.lower_rad, self.limits.upper_rad
@@ -248,7 +260,7 @@ class JointController:
         sent = np.where(leaving, pos, sent)  # first tick out of PWM starts from the encoder
         sent, sent_clamped = clamp_reference(sent, lower, upper)
 
-        duty, saturated = pwm_duty(sent, pos, vel, gains)
+        duty, saturated = pwm_duty(sent, pos, vel, gains, pwm_command_pct)
         duty = np.where(want_pwm, duty, 0.0)
         saturated &= want_pwm
         limp = want_pwm & (((gains.kp == 0) & (gains.kd == 0)) | (gains.max_pwm_pct == 0))

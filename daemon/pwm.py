@@ -41,6 +41,7 @@ import numpy as np
 
 from robot.errors import InputError
 from robot.joints import JOINT_INDEX, JOINT_NAMES, NUM_JOINTS
+from robot.motors import MotorTable, motor_table
 from robot.pwm_gains import (
     KD_LIMIT,
     KP_LIMIT,
@@ -56,6 +57,7 @@ __all__ = [
     "PwmGains",
     "default_drc_gains",
     "duty_to_board_units",
+    "feedforward_duty_pct",
     "pwm_duty",
     "validate_pwm_gains",
 ]
@@ -264,11 +266,38 @@ def default_drc_gains() -> PwmGains:
     return PwmGains.from_table(safe_default_gain_table())
 
 
+def feedforward_duty_pct(torque_nm: np.ndarray, battery_v: float,
+                         vel_rad_s: np.ndarray | None = None,
+                         table: MotorTable | None = None) -> np.ndarray:
+    """The feed-forward duty (``pwm_command`` [%]) with which a joint on its reference,
+    moving at ``vel_rad_s``, gives ``torque_nm``; within ``±PWM_COMMAND_LIMIT_PCT``.
+
+    On the reference the duty is ``−pwm_command + kd·vel`` and the motor gives
+    ``torque_per_duty·duty − b·vel`` (`robot.motors`, b the back-EMF damping), so
+    ``pwm_command = −(τ + b·vel) / torque_per_duty`` with kd = 0. Planned velocities are
+    fed forward, not measured ones: cancelling the back-EMF with the measured velocity
+    would take the arm's damping away.
+
+    Args:
+        torque_nm: wanted joint torque [N·m], shape (40,).
+        battery_v: bus voltage [V].
+        vel_rad_s: planned joint velocity [rad/s], shape (40,); at rest when None.
+        table: motor constants; the robot's when None.
+    """
+    motors = table or motor_table()
+    torque = np.asarray(torque_nm, dtype=float)
+    if vel_rad_s is not None:
+        torque = torque + motors.back_emf_damping * np.asarray(vel_rad_s, dtype=float)
+    duty = -torque / motors.torque_per_duty(battery_v)
+    return np.clip(duty, -PWM_COMMAND_LIMIT_PCT, PWM_COMMAND_LIMIT_PCT)
+
+
 def pwm_duty(
     ref_rad: np.ndarray,
     pos_rad: np.ndarray,
     vel_rad_s: np.ndarray,
     gains: PwmGains,
+    pwm_command_pct: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """The PWM duty of every joint, hubo-ach's formula and sign.
 
@@ -279,12 +308,14 @@ def pwm_duty(
         pos_rad: measured position [rad], shape (40,).
         vel_rad_s: measured velocity [rad/s], shape (40,).
         gains: validated gains.
+        pwm_command_pct: feed-forward duty [%] replacing ``gains.pwm_command_pct``.
 
     Returns:
         ``(duty_pct, saturated)``: duty [%] in ``[−max_pwm, max_pwm]`` and a bool mask of
         the joints where the clamp acted.
     """
-    raw = -(gains.kp * (ref_rad - pos_rad) - gains.kd * vel_rad_s + gains.pwm_command_pct)
+    command = gains.pwm_command_pct if pwm_command_pct is None else pwm_command_pct
+    raw = -(gains.kp * (ref_rad - pos_rad) - gains.kd * vel_rad_s + command)
     duty = np.clip(raw, -gains.max_pwm_pct, gains.max_pwm_pct)
     return duty, duty != raw
 

@@ -25,6 +25,13 @@ Modes. The reference mode of every joint is FILTER, or DIRECT with ``no_filter``
 per line from a sidecar run-length schedule; ``-c``/``-cl``/``-cr`` force the named arm(s)
 to PWM for the whole file, overriding the schedule for that arm only. The wrist roll is
 asked to comply with its arm; the control law (``daemon.joint_control``) knows it cannot.
+
+Feed-forward. A compliant arm that tracks its reference gives almost no torque, so a
+sidecar may carry the torques the plan needs from the gripping arms
+(`robot.plan_sidecar.ArmFeedforward`); each tick carries them, interpolated between the
+sampled lines, for the joints in PWM mode (0 elsewhere, and during go-to-init), with the
+file's velocity on the line (the motor's back-EMF costs duty while it moves). The
+caller turns them into hubo-ach's feed-forward duty (``pwm_command``).
 """
 
 from __future__ import annotations
@@ -39,6 +46,7 @@ import numpy as np
 from daemon.control_modes import RefMode
 from robot.errors import HuboLadderError, InputError
 from robot.joints import ARM_JOINTS, NUM_JOINTS, joint_indices
+from robot.plan_sidecar import ArmFeedforward
 
 __all__ = [
     "ALLOWED_RATES_HZ",
@@ -256,6 +264,9 @@ class PlayerTick:
         ref_rad: reference per joint [rad], shape (40,).
         mode: :class:`~daemon.control_modes.RefMode` per joint, shape (40,) int8.
         comply: joints asked to be compliant (PWM), shape (40,) bool.
+        feedforward_nm: feed-forward torque of the compliant joints [N·m], shape (40,).
+        velocity_rad_s: the file's velocity on this line, (next row − row)·rate
+            [rad/s], shape (40,); 0 during go-to-init and pauses and after the end.
         line_index: 0-based trajectory row being played (the start row during go-to-init).
         arm_modes: arm → ``"position"`` or ``"pwm"``.
         going_to_init: the go-to-init move is in progress.
@@ -268,6 +279,8 @@ class PlayerTick:
     ref_rad: np.ndarray
     mode: np.ndarray
     comply: np.ndarray
+    feedforward_nm: np.ndarray
+    velocity_rad_s: np.ndarray
     line_index: int
     arm_modes: Mapping[str, str]
     going_to_init: bool
@@ -307,10 +320,11 @@ class TrajectoryPlayer:
         options: playback options; defaults (25 Hz, no init, filter mode) when None.
         schedule: per-arm mode schedule (``ArmModeSchedule`` or the sidecar's run-length
             mapping); both arms in position mode when None.
+        feedforward: the sidecar's arm torques; no feed-forward when None.
 
     Raises:
         PlayerOptionError: a bad trajectory array, or ``start_line`` beyond its end.
-        ModeScheduleError: a bad schedule.
+        ModeScheduleError: a bad schedule, or feed-forward rows that do not cover the file.
     """
 
     def __init__(
@@ -318,6 +332,7 @@ class TrajectoryPlayer:
         trajectory_rad: np.ndarray,
         options: PlayerOptions | None = None,
         schedule: ArmModeSchedule | Mapping[str, Sequence[tuple[int, int, str]]] | None = None,
+        feedforward: ArmFeedforward | None = None,
     ):
         self.options = options or PlayerOptions()
         traj = np.array(trajectory_rad, dtype=float)
@@ -362,6 +377,12 @@ class TrajectoryPlayer:
                 mask[arm_idx["right"]] = right
                 mask.setflags(write=False)
                 self._comply[(left, right)] = mask
+        if feedforward is not None and len(feedforward.torque_nm) != feedforward.rows_for(n):
+            raise ModeScheduleError(
+                f"feed-forward has {len(feedforward.torque_nm)} rows; {n} lines every "
+                f"{feedforward.every_lines} need {feedforward.rows_for(n)}")
+        self._feedforward = feedforward
+        self._ff_cols = None if feedforward is None else joint_indices(feedforward.joints)
         self._start_row = self.options.start_line - 1
         self._init_s = self.options.go_to_init_s if self.options.go_to_init else 0.0
         self._t0_s: float | None = None
@@ -474,10 +495,20 @@ class TrajectoryPlayer:
             ref = self.trajectory_rad[row].copy()
         left = bool(self._pwm_by_line["left"][row])
         right = bool(self._pwm_by_line["right"][row])
+        comply = self._comply[(left, right)]
+        feedforward = np.zeros(NUM_JOINTS)
+        if self._feedforward is not None and not going_to_init:
+            feedforward[self._ff_cols] = self._feedforward_at(row)
+            feedforward[~comply] = 0.0
+        moving = not (going_to_init or finished or self.paused) and row + 1 < self.num_lines
+        velocity = ((self.trajectory_rad[row + 1] - self.trajectory_rad[row])
+                    * self.options.rate_hz if moving else np.zeros(NUM_JOINTS))
         return PlayerTick(
             ref_rad=ref,
             mode=self._mode,
-            comply=self._comply[(left, right)],
+            comply=comply,
+            feedforward_nm=feedforward,
+            velocity_rad_s=velocity,
             line_index=row,
             arm_modes=MappingProxyType({"left": ARM_MODES[left], "right": ARM_MODES[right]}),
             going_to_init=going_to_init,
@@ -486,6 +517,15 @@ class TrajectoryPlayer:
         )
 
     # ----------------------------------------------------------------- internals
+    def _feedforward_at(self, row: int) -> np.ndarray:
+        """The feed-forward torques of 0-based ``row``, linear between sampled rows."""
+        ff = self._feedforward
+        k, rest = divmod(row, ff.every_lines)
+        if rest == 0:
+            return ff.torque_nm[k]
+        u = rest / ff.every_lines
+        return (1.0 - u) * ff.torque_nm[k] + u * ff.torque_nm[k + 1]
+
     def _clock(self, now_s: float) -> float:
         if not self.started:
             raise PlayerStateError("start the player (or step it once) before pausing")

@@ -6,7 +6,8 @@ One loop iteration is one 5 ms daemon tick, run as fast as the CPU allows:
 2. the `execute.player.TrajectoryPlayer` gives the reference, modes and compliance for
    ``n · 5 ms``;
 3. the `daemon.joint_control.JointController` (the code the daemon runs) turns them
-   into sent references and PWM duties;
+   into sent references and PWM duties, the compliant arms' feed-forward torques (the
+   sidecar's `ArmFeedforward`) into feed-forward duty at the board's battery voltage;
 4. the `daemon.board_model.BoardModel` applies them and steps the physics one tick;
 5. the `execute.verdict.VerdictMonitor` checks for a failure.
 
@@ -34,7 +35,7 @@ from daemon.board_model import TICK_S, BoardModel, BoardModelConfig, PlacementEr
 from daemon.board_trip import TripEvent
 from daemon.grasp_latch import GraspEvent
 from daemon.joint_control import JointController
-from daemon.pwm import PwmGains, default_drc_gains
+from daemon.pwm import PwmGains, default_drc_gains, feedforward_duty_pct
 from execute.player import ArmModeSchedule, PlayerOptions, TrajectoryPlayer
 from execute.verdict import Verdict, VerdictConfig, VerdictMonitor
 from ladders.geometry import LadderGeometry
@@ -131,6 +132,9 @@ def simulate(trajectory_rad: np.ndarray, sidecar: PlanSidecar, ladder: LadderSpe
         ladder: the ladder the plan was made for (the placement error is applied here).
         options: strategy, misplacement, battery...
         robot: robot name.
+
+    The sidecar's arm feed-forward is played under every strategy; it acts only on
+    joints in PWM mode.
     """
     opt = options or SimulationOptions()
     n = len(trajectory_rad)
@@ -148,7 +152,7 @@ def simulate(trajectory_rad: np.ndarray, sidecar: PlanSidecar, ladder: LadderSpe
     rate = int(round(sidecar.rate_hz))
     player = TrajectoryPlayer(trajectory_rad, PlayerOptions(rate_hz=rate,
                                                             compliant_arms=compliant),
-                              schedule)
+                              schedule, sidecar.arm_feedforward)
     controller = JointController(robot=robot)
     gains = opt.gains or default_drc_gains()
     monitor = VerdictMonitor(board, sidecar, T_err, player.time_of_line, opt.verdict)
@@ -180,7 +184,10 @@ def simulate(trajectory_rad: np.ndarray, sidecar: PlanSidecar, ladder: LadderSpe
         vel_now = board.joint_vel()
         tick = player.step(now, pos_now)
         line_index = tick.line_index
-        out = controller.tick(tick.ref_rad, tick.mode, tick.comply, pos_now, vel_now, gains)
+        feedforward = None if sidecar.arm_feedforward is None else feedforward_duty_pct(
+            tick.feedforward_nm, opt.board.battery_v, tick.velocity_rad_s, board.motors)
+        out = controller.tick(tick.ref_rad, tick.mode, tick.comply, pos_now, vel_now, gains,
+                              feedforward)
         board.apply(out)
         trips, grasps = board.step()
         trips_all += trips

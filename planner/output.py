@@ -24,7 +24,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from robot.joints import ARM_JOINTS
 from robot.plan_sidecar import (
+    ArmFeedforward,
     HoldRecord,
     PlanSidecar,
     Segment,
@@ -48,6 +50,9 @@ __all__ = ["PWM_RAIL_DISTANCE_M", "PlanOutput", "arm_mode_runs",
 PWM_RAIL_DISTANCE_M = 0.03
 #: Clearance is measured on every this-many-th line (a distance query is slow).
 CLEARANCE_EVERY_LINES = 20
+#: The arms' feed-forward torques are sampled every this-many lines (0.1 s at 200 Hz:
+#: a quasi-static climb's load shifts over seconds).
+FEEDFORWARD_EVERY_LINES = 20
 ARMS = ("left", "right")
 
 
@@ -224,6 +229,42 @@ def _sidecar_segments(result: SearchResult, timed: TimedPlan,
     return out
 
 
+def arm_feedforward(result: SearchResult, timed: TimedPlan, after: list[dict[str, Hold]],
+                    checker, every_lines: int = FEEDFORWARD_EVERY_LINES) -> ArmFeedforward:
+    """The arm joint torques of the torque LP along the timed plan, every ``every_lines``.
+
+    Each sampled line is held on the stance the search checked it against (its segment's
+    holds; a step's holds after it for the dwell lines), with the limits of
+    ``checker.torque_limits`` (a gripping arm gets what the plan's arm strategy lets it
+    give). An arm whose hand holds nothing gets its own gravity torques: a compliant arm
+    closing on a rail must not sag onto a lower point of it. A line whose LP has no
+    solution (none should: every planned configuration passed it) keeps the previous
+    sample's torques.
+    """
+    from planner.contacts import Stance
+
+    step_of_segment = {i: g for g, idx in enumerate(step_groups(result.segments)) for i in idx}
+    joints = tuple(n for side in ARMS for n in ARM_JOINTS[side])
+    ff = ArmFeedforward(every_lines, joints, np.zeros((0, len(joints))))
+    rows = ff.rows_for(timed.line_count)
+    torque = np.zeros((rows, len(joints)))
+    stances: dict[tuple[int, bool], Stance] = {}
+    for k in range(rows):
+        i = min(k * every_lines, timed.line_count - 1)
+        key = (int(timed.segment_of_line[i]), bool(timed.dwell[i]))
+        if key not in stances:
+            holds = (after[step_of_segment[key[0]]].values() if key[1]
+                     else result.segments[key[0]].holds)
+            stances[key] = Stance(tuple(holds))
+        check = checker.holding_torques(timed.configs[i], stances[key])
+        if check.equilibrium:
+            torque[k] = [check.torque(n) for n in joints]
+        elif k:
+            torque[k] = torque[k - 1]
+    torque.setflags(write=False)
+    return ArmFeedforward(every_lines, joints, torque)
+
+
 def _finite(x: float) -> float | None:
     return float(x) if np.isfinite(x) else None
 
@@ -320,6 +361,7 @@ def write_plan(result: SearchResult, planner: ClimbPlanner, out_traj: str | os.P
             if h is not None and h.target.startswith("rail"):
                 holding[s.first_line - 1:s.last_line] = True
         arm_modes[side] = arm_mode_runs(holding | (distances[side] <= PWM_RAIL_DISTANCE_M))
+    feedforward = arm_feedforward(result, timed, after, planner.checker)
     metrics = _metrics(result, planner, timed, segments, clearance_every)
     metrics["palm_rail_pwm_distance_m"] = PWM_RAIL_DISTANCE_M
     metrics["arm_strategy"] = planner.config.arm_strategy
@@ -335,7 +377,7 @@ def write_plan(result: SearchResult, planner: ClimbPlanner, out_traj: str | os.P
         final_holds={h.limb: _record(h) for h in sorted(result.final_stance.holds,
                                                          key=lambda h: h.limb)},
         seed=int(planner.seed), metrics=metrics, timings_s=all_timings,
-        planner_version=planner_version())
+        planner_version=planner_version(), arm_feedforward=feedforward)
     side_path = sidecar_path(out_traj)
     write_sidecar(side_path, sidecar)
     log.info("wrote %s (%d lines, %.1f s) and %s", out_traj, timed.line_count,

@@ -23,8 +23,10 @@ from planner.contacts import Stance
 from planner.kinematics import HuboKinematics
 from planner.stability import (
     SupportRegion,
+    TorqueCheck,
     check_stability,
     support_region,
+    torque_feasibility,
     torque_limits_by_joint,
 )
 
@@ -119,6 +121,11 @@ class FeasibilityChecker:
                    f"torque {ratio:.2f}× limit at {report.torque.worst_joint}")
             return Verdict(False, why, report.margin_m, ratio)
         return Verdict(True, "ok", report.margin_m, ratio)
+
+    def holding_torques(self, q: np.ndarray, stance: Stance) -> TorqueCheck:
+        """The torque LP's joint torques that hold ``q`` on ``stance`` (limits as `check`)."""
+        return torque_feasibility(self.kin.model, self.kin.data, q, stance,
+                                  self.torque_limits(stance), self.frame_ids)
 
     def clearance(self, q: np.ndarray, contacts: dict[str, str]) -> float:
         """Smallest distance over the active collision pairs [m] (slower: for reports)."""

@@ -12,8 +12,10 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from robot.errors import InputError
-from robot.joints import JOINT_NAMES
+from robot.joints import ARM_JOINTS, JOINT_NAMES
 
 FORMAT = "hubo-ladder-plan"
 VERSION = 1
@@ -56,6 +58,35 @@ class Segment:
     moving_limbs: tuple[str, ...] = ()
 
 
+@dataclass(frozen=True, eq=False)
+class ArmFeedforward:
+    """Joint torques the compliant arms must give so that the robot carries its load the
+    way the plan's torque LP shares it between hands and feet.
+
+    A PWM arm that tracks its reference gives almost no torque (its duty is kp times a
+    small error), so the position-controlled legs would take the whole load; the player
+    sends these torques as the arm's feed-forward duty (hubo-ach's ``pwm_command``).
+
+    Attributes:
+        every_lines: sample spacing [lines]; row k belongs to line ``1 + k·every_lines``
+            and the player interpolates linearly between rows.
+        joints: the arm joints of the columns (names of `robot.joints.ARM_JOINTS`).
+        torque_nm: (rows, len(joints)) joint torques [N·m]; 0 where the hand holds nothing.
+    """
+
+    every_lines: int
+    joints: tuple[str, ...]
+    torque_nm: np.ndarray
+
+    def rows_for(self, line_count: int) -> int:
+        """Rows that sample lines 1..line_count: the last row is at or past the last line."""
+        return (line_count - 2) // self.every_lines + 2 if line_count > 1 else 1
+
+    def to_json(self) -> dict[str, Any]:
+        return {"every_lines": self.every_lines, "joints": list(self.joints),
+                "torque_nm": [[round(float(v), 3) for v in row] for row in self.torque_nm]}
+
+
 @dataclass(frozen=True)
 class PlanSidecar:
     robot: str
@@ -70,6 +101,7 @@ class PlanSidecar:
     timings_s: dict[str, float] = field(default_factory=dict)
     planner_version: str = ""
     joint_order: tuple[str, ...] = JOINT_NAMES
+    arm_feedforward: ArmFeedforward | None = None
 
     def segment_at(self, line: int) -> Segment:
         for seg in self.segments:
@@ -81,6 +113,10 @@ class PlanSidecar:
         d = asdict(self)
         d = {"format": FORMAT, "version": VERSION, **d}
         d["joint_order"] = list(self.joint_order)
+        if self.arm_feedforward is None:
+            del d["arm_feedforward"]
+        else:
+            d["arm_feedforward"] = self.arm_feedforward.to_json()
         return d
 
 
@@ -137,6 +173,32 @@ def _runs(runs: Any, where: str, line_count: int) -> list[tuple[int, int, str]]:
     return out
 
 
+def _feedforward(d: Any, where: str, line_count: int) -> ArmFeedforward | None:
+    if d is None:
+        return None
+    if not isinstance(d, dict) or set(d) != {"every_lines", "joints", "torque_nm"}:
+        raise SidecarError(f"{where}: expected 'every_lines', 'joints' and 'torque_nm'")
+    every, joints = d["every_lines"], d["joints"]
+    if not isinstance(every, int) or isinstance(every, bool) or every < 1:
+        raise SidecarError(f"{where}.every_lines: expected an integer >= 1, got {every!r}")
+    arm = {n for side in ARM_JOINTS.values() for n in side}
+    if not isinstance(joints, list) or not joints or any(j not in arm for j in joints) \
+            or len(set(joints)) != len(joints):
+        raise SidecarError(f"{where}.joints: expected distinct arm joint names "
+                           f"({' '.join(sorted(arm))}), got {joints!r}")
+    ff = ArmFeedforward(every, tuple(joints), np.zeros((0, len(joints))))
+    rows = ff.rows_for(line_count)
+    try:
+        torque = np.array(d["torque_nm"], dtype=float)
+    except (TypeError, ValueError):
+        torque = None
+    if torque is None or torque.shape != (rows, len(joints)) or not np.isfinite(torque).all():
+        raise SidecarError(f"{where}.torque_nm: expected {rows} rows of {len(joints)} finite "
+                           f"torques [N·m] (lines 1..{line_count} every {every})")
+    torque.setflags(write=False)
+    return ArmFeedforward(every, tuple(joints), torque)
+
+
 def read_sidecar(path: str | os.PathLike) -> PlanSidecar:
     """Read and validate a sidecar. Raises `SidecarError` naming the file and the field."""
     path = Path(path)
@@ -172,7 +234,9 @@ def read_sidecar(path: str | os.PathLike) -> PlanSidecar:
             segments=tuple(segments), arm_modes=arm_modes,
             final_holds=_holds(d["final_holds"], f"{path}: final_holds"),
             seed=int(d.get("seed", 0)), metrics=d.get("metrics", {}),
-            timings_s=d.get("timings_s", {}), planner_version=d.get("planner_version", ""))
+            timings_s=d.get("timings_s", {}), planner_version=d.get("planner_version", ""),
+            arm_feedforward=_feedforward(d.get("arm_feedforward"), f"{path}: arm_feedforward",
+                                         n))
     except KeyError as exc:
         raise SidecarError(f"{path}: missing field {exc.args[0]!r}") from None
     except (TypeError, ValueError) as exc:

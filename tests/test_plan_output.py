@@ -18,9 +18,15 @@ from synthetic_plan import synthetic_plan  # noqa: E402
 from ladders.loader import parse_ladder_yaml  # noqa: E402
 from planner import output  # noqa: E402
 from planner.contacts import Hold  # noqa: E402
-from planner.output import PWM_RAIL_DISTANCE_M, arm_mode_runs, write_plan  # noqa: E402
+from planner.output import (  # noqa: E402
+    FEEDFORWARD_EVERY_LINES,
+    PWM_RAIL_DISTANCE_M,
+    arm_mode_runs,
+    write_plan,
+)
 from planner.search import SearchResult  # noqa: E402
-from robot.plan_sidecar import read_sidecar, sidecar_path  # noqa: E402
+from robot.joints import ARM_JOINTS  # noqa: E402
+from robot.plan_sidecar import SidecarError, read_sidecar, sidecar_path  # noqa: E402
 from robot.trajectory_file import read_trajectory  # noqa: E402
 
 
@@ -144,3 +150,43 @@ def test_start_configuration_defaults_to_the_planners(plan, written, tmp_path):
     planner, result, q0 = plan
     out = write_plan(result, planner, tmp_path / "d.traj", 200.0, clearance_every=0)
     assert out.traj_path.read_bytes() == written.traj_path.read_bytes()
+
+
+def test_arm_feedforward_is_each_free_arms_gravity_torque(plan, written):
+    """With only the feet on the floor no contact force reaches an arm, so the torque LP's
+    arm torques must be the arms' gravity torques (pinocchio's g(q), independently)."""
+    import pinocchio as pin
+
+    planner, _, _ = plan
+    sc = read_sidecar(written.sidecar_path)
+    ff = sc.arm_feedforward
+    assert ff.every_lines == FEEDFORWARD_EVERY_LINES
+    assert len(ff.torque_nm) == ff.rows_for(sc.line_count)
+    assert set(ff.joints) == set(ARM_JOINTS["left"]) | set(ARM_JOINTS["right"])
+    np.testing.assert_allclose(ff.torque_nm, written.sidecar.arm_feedforward.torque_nm,
+                               atol=5e-4)  # the file keeps 1 mN·m
+    model, data = planner.kin.model, planner.kin.data
+    v_index = [model.joints[model.getJointId(n)].idx_v for n in ff.joints]
+    for k in (0, len(ff.torque_nm) // 2, len(ff.torque_nm) - 1):
+        q = written.timed.configs[min(k * ff.every_lines, sc.line_count - 1)]
+        gravity = pin.computeGeneralizedGravity(model, data, q)[v_index]
+        np.testing.assert_allclose(ff.torque_nm[k], gravity, atol=1e-3)
+    assert np.abs(ff.torque_nm).max() > 1.0  # arms hanging forward do weigh
+
+
+def test_sidecar_feedforward_is_validated(written, tmp_path):
+    import json
+
+    d = json.loads(written.sidecar_path.read_text())
+    d["arm_feedforward"]["torque_nm"] = d["arm_feedforward"]["torque_nm"][:-1]
+    bad = tmp_path / "bad.plan.json"
+    bad.write_text(json.dumps(d))
+    with pytest.raises(SidecarError, match=r"arm_feedforward.torque_nm: expected \d+ rows"):
+        read_sidecar(bad)
+    d["arm_feedforward"]["joints"][0] = "RKN"
+    bad.write_text(json.dumps(d))
+    with pytest.raises(SidecarError, match="arm_feedforward.joints: expected distinct arm"):
+        read_sidecar(bad)
+    del d["arm_feedforward"]
+    bad.write_text(json.dumps(d))
+    assert read_sidecar(bad).arm_feedforward is None  # older sidecars: no feed-forward

@@ -20,6 +20,7 @@ from execute.player import (
 )
 from robot.errors import InputError
 from robot.joints import ARM_JOINTS, JOINT_INDEX, joint_indices
+from robot.plan_sidecar import ArmFeedforward
 
 N = 40
 LEFT = joint_indices(ARM_JOINTS["left"])
@@ -291,3 +292,49 @@ def test_player_drives_the_control_law_through_a_mode_switch():
     assert {h[1] for h in history if h[0] < 6 or h[0] > 12} == {False}
     first_after = next(h for h in history if h[0] == 13)
     assert first_after == (13, False, True)  # leaves PWM into the rigid return
+
+
+# ------------------------------------------------------------------ feed-forward
+def _feedforward(num_lines: int, every: int) -> ArmFeedforward:
+    """Row k: LSP = k N·m, RSP = −k N·m (the other arm joints 0)."""
+    probe = ArmFeedforward(every, ("LSP", "RSP"), np.zeros((0, 2)))
+    k = np.arange(probe.rows_for(num_lines), dtype=float)
+    return ArmFeedforward(every, ("LSP", "RSP"), np.stack([k, -k], axis=1))
+
+
+def test_feedforward_is_interpolated_between_sampled_lines_for_pwm_joints_only():
+    ff = _feedforward(20, 4)
+    assert len(ff.torque_nm) == 6  # lines 1, 5, 9, 13, 17, 21 ≥ 20
+    p = TrajectoryPlayer(_ramp(20), schedule=SCHEDULE, feedforward=ff)
+    lsp, rsp = JOINT_INDEX["LSP"], JOINT_INDEX["RSP"]
+    seen = {}
+    for n in range(20 * 8):
+        t = p.step(n * TICK_S)
+        seen[t.line_number] = (t.feedforward_nm[lsp], t.feedforward_nm[rsp])
+        assert not t.feedforward_nm[~t.comply].any()
+    assert seen[6] == pytest.approx((1.25, 0.0))  # row 5 = 5/4 of the way; right arm rigid
+    assert seen[9] == pytest.approx((2.0, 0.0))  # a sampled line
+    assert seen[12] == pytest.approx((2.75, 0.0))
+    assert seen[13] == (0.0, 0.0)  # left arm back in position mode
+    both = TrajectoryPlayer(_ramp(20), PlayerOptions(compliant_arms={"left", "right"}),
+                            feedforward=ff)
+    both.step(0.0)
+    assert both.step(19 / 25).feedforward_nm[rsp] == pytest.approx(-19 / 4)  # line 20
+
+
+def test_feedforward_is_off_during_go_to_init_and_velocity_is_the_files():
+    ff = _feedforward(20, 4)
+    opts = PlayerOptions(go_to_init=True, compliant_arms={"left"})
+    p = TrajectoryPlayer(_ramp(20), opts, feedforward=ff)
+    t = p.step(0.0, np.zeros(N))
+    assert t.going_to_init and not t.feedforward_nm.any() and not t.velocity_rad_s.any()
+    t = p.step(3.0 + 2 / 25)  # line 3
+    assert t.feedforward_nm[JOINT_INDEX["LSP"]] == pytest.approx(0.5)
+    np.testing.assert_allclose(t.velocity_rad_s, 0.01 * 25)  # 0.01 rad per line at 25 Hz
+    t = p.step(100.0)
+    assert t.finished and not t.velocity_rad_s.any()
+
+
+def test_feedforward_must_cover_the_file():
+    with pytest.raises(ModeScheduleError, match="feed-forward has 6 rows; 40 lines every 4 need 11"):
+        TrajectoryPlayer(_ramp(40), feedforward=_feedforward(20, 4))

@@ -10,15 +10,24 @@ from daemon.pwm import (
     PwmGains,
     default_drc_gains,
     duty_to_board_units,
+    feedforward_duty_pct,
     pwm_duty,
     validate_pwm_gains,
 )
 from robot.errors import InputError
 from robot.joints import JOINT_INDEX, JOINT_NAMES
-from robot.pwm_gains import DRC_DOCUMENTED_GAINS, KD_LIMIT, KP_LIMIT, MAX_PWM_LIMIT_PCT
+from robot.motors import motor_table, pwm_torque
+from robot.pwm_gains import (
+    DRC_DOCUMENTED_GAINS,
+    KD_LIMIT,
+    KP_LIMIT,
+    MAX_PWM_LIMIT_PCT,
+    PWM_COMMAND_LIMIT_PCT,
+)
 
 N = 40
 J = JOINT_INDEX
+ZERO_N = np.zeros(N)
 
 
 def test_documented_table_is_kept_verbatim():
@@ -148,3 +157,30 @@ def test_repr_lists_active_joints():
     r = repr(default_drc_gains())
     assert "RSP=69/0/7.9" in r and "RKN" not in r
     assert JOINT_NAMES[0] not in repr(PwmGains.zeros())
+
+
+def test_feedforward_duty_gives_the_torque_at_rest_and_moving():
+    """pwm_command from `feedforward_duty_pct` makes the motor model give the torque asked,
+    at rest and at the planned velocity (back-EMF fed forward), at any battery voltage."""
+    table = motor_table()
+    g = default_drc_gains()
+    want = np.zeros(N)
+    want[J["LSP"]], want[J["REB"]], want[J["LWP"]] = -4.0, 2.5, 0.8
+    vel = np.zeros(N)
+    vel[J["LSP"]], vel[J["REB"]] = 0.05, -0.02
+    for volts in (48.0, 42.0):
+        for v in (np.zeros(N), vel):
+            command = feedforward_duty_pct(want, volts, v, table)
+            duty, sat = pwm_duty(ZERO_N, ZERO_N, v, g, command)  # on the reference, kd = 0
+            assert not sat.any()
+            np.testing.assert_allclose(pwm_torque(duty, v, volts, table), want, atol=1e-12)
+    command = feedforward_duty_pct(want, 48.0)
+    np.testing.assert_array_equal(np.sign(command), np.sign(want))  # +command gives +τ
+
+
+def test_feedforward_duty_stays_within_the_command_limit_and_the_clamp_still_acts():
+    huge = np.full(N, 1e4)
+    command = feedforward_duty_pct(huge, 48.0)
+    assert (np.abs(command) <= PWM_COMMAND_LIMIT_PCT).all()
+    duty, sat = pwm_duty(ZERO_N, ZERO_N, ZERO_N, default_drc_gains(), command)
+    assert (np.abs(duty) <= default_drc_gains().max_pwm_pct).all() and sat[J["LSP"]]
