@@ -27,11 +27,20 @@ to PWM for the whole file, overriding the schedule for that arm only. The wrist 
 asked to comply with its arm; the control law (``daemon.joint_control``) knows it cannot.
 
 Feed-forward. A compliant arm that tracks its reference gives almost no torque, so a
-sidecar may carry the torques the plan needs from the gripping arms
-(`robot.plan_sidecar.ArmFeedforward`); each tick carries them, interpolated between the
-sampled lines, for the joints in PWM mode (0 elsewhere, and during go-to-init), with the
-file's velocity on the line (the motor's back-EMF costs duty while it moves). The
-caller turns them into hubo-ach's feed-forward duty (``pwm_command``).
+sidecar may carry the arm torques the plan needs (`robot.plan_sidecar.ArmFeedforward`:
+the torque LP's share of the load for a hand on a rail, the arm's own weight for a hand
+in the air); each tick carries them, interpolated between the sampled lines, for the
+joints in PWM mode (0 elsewhere, and during go-to-init), with the velocity the daemon's
+reference filter will give the reference (the motor's back-EMF costs duty while it
+moves). The caller turns them into hubo-ach's feed-forward duty (``pwm_command``).
+
+Force control of a holding arm. With feed-forward, on lines where the sidecar says a
+hand holds its rail (``holding``) and its arm is in PWM mode, the arm's compliant joints
+are sent in mode COMPLIANT (``f = pos``): the duty is the feed-forward alone, so the arm
+gives the planned share of the load instead of a stiffness pushing it towards a pose
+the rail does not let it reach (a closed chain's load would otherwise follow the
+joints' stiffness, not the plan). The wrist roll cannot switch to PWM, but in mode
+COMPLIANT its position loop follows its encoder, so it does not twist the grip either.
 """
 
 from __future__ import annotations
@@ -43,7 +52,7 @@ from types import MappingProxyType
 
 import numpy as np
 
-from daemon.control_modes import RefMode
+from daemon.control_modes import TICK_S, RefMode, default_filter_config, filter_reference
 from robot.errors import HuboLadderError, InputError
 from robot.joints import ARM_JOINTS, NUM_JOINTS, joint_indices
 from robot.plan_sidecar import ArmFeedforward
@@ -265,8 +274,8 @@ class PlayerTick:
         mode: :class:`~daemon.control_modes.RefMode` per joint, shape (40,) int8.
         comply: joints asked to be compliant (PWM), shape (40,) bool.
         feedforward_nm: feed-forward torque of the compliant joints [N·m], shape (40,).
-        velocity_rad_s: the file's velocity on this line, (next row − row)·rate
-            [rad/s], shape (40,); 0 during go-to-init and pauses and after the end.
+        velocity_rad_s: velocity of the reference as the daemon's filter sends it
+            [rad/s], shape (40,); 0 during go-to-init and pauses.
         line_index: 0-based trajectory row being played (the start row during go-to-init).
         arm_modes: arm → ``"position"`` or ``"pwm"``.
         going_to_init: the go-to-init move is in progress.
@@ -321,6 +330,9 @@ class TrajectoryPlayer:
         schedule: per-arm mode schedule (``ArmModeSchedule`` or the sidecar's run-length
             mapping); both arms in position mode when None.
         feedforward: the sidecar's arm torques; no feed-forward when None.
+        holding: arm → bool (N,), lines on which its hand holds a rail
+            (`robot.plan_sidecar.PlanSidecar.hand_holding`); with ``feedforward``, those
+            lines are force-controlled (module docstring). None: no line.
 
     Raises:
         PlayerOptionError: a bad trajectory array, or ``start_line`` beyond its end.
@@ -333,6 +345,7 @@ class TrajectoryPlayer:
         options: PlayerOptions | None = None,
         schedule: ArmModeSchedule | Mapping[str, Sequence[tuple[int, int, str]]] | None = None,
         feedforward: ArmFeedforward | None = None,
+        holding: Mapping[str, np.ndarray] | None = None,
     ):
         self.options = options or PlayerOptions()
         traj = np.array(trajectory_rad, dtype=float)
@@ -383,6 +396,15 @@ class TrajectoryPlayer:
                 f"{feedforward.every_lines} need {feedforward.rows_for(n)}")
         self._feedforward = feedforward
         self._ff_cols = None if feedforward is None else joint_indices(feedforward.joints)
+        self._holding = {arm: np.zeros(n, dtype=bool) for arm in ARMS}
+        for arm, lines in (holding or {}).items():
+            lines = np.asarray(lines, dtype=bool)
+            if arm not in ARMS or lines.shape != (n,):
+                raise ModeScheduleError(f"holding[{arm!r}] must be {n} flags of an arm "
+                                        f"({', '.join(ARMS)})")
+            self._holding[arm] = lines
+        self._force_cols = {arm: joint_indices(ARM_JOINTS[arm]) for arm in ARMS}
+        self._filtered_rad: np.ndarray | None = None
         self._start_row = self.options.start_line - 1
         self._init_s = self.options.go_to_init_s if self.options.go_to_init else 0.0
         self._t0_s: float | None = None
@@ -496,16 +518,21 @@ class TrajectoryPlayer:
         left = bool(self._pwm_by_line["left"][row])
         right = bool(self._pwm_by_line["right"][row])
         comply = self._comply[(left, right)]
+        velocity = self._filter_velocity(ref, going_to_init)
         feedforward = np.zeros(NUM_JOINTS)
+        mode = self._mode
         if self._feedforward is not None and not going_to_init:
             feedforward[self._ff_cols] = self._feedforward_at(row)
             feedforward[~comply] = 0.0
-        moving = not (going_to_init or finished or self.paused) and row + 1 < self.num_lines
-        velocity = ((self.trajectory_rad[row + 1] - self.trajectory_rad[row])
-                    * self.options.rate_hz if moving else np.zeros(NUM_JOINTS))
+            held = [arm for arm, pwm in (("left", left), ("right", right))
+                    if pwm and self._holding[arm][row]]
+            if held:
+                mode = self._mode.copy()
+                for arm in held:
+                    mode[self._force_cols[arm]] = RefMode.COMPLIANT
         return PlayerTick(
             ref_rad=ref,
-            mode=self._mode,
+            mode=mode,
             comply=comply,
             feedforward_nm=feedforward,
             velocity_rad_s=velocity,
@@ -517,6 +544,19 @@ class TrajectoryPlayer:
         )
 
     # ----------------------------------------------------------------- internals
+    def _filter_velocity(self, ref: np.ndarray, going_to_init: bool) -> np.ndarray:
+        """Velocity of ``ref`` through the daemon's reference filter [rad/s] (0 while
+        paused or going to the start line, where the filter is reset onto ``ref``)."""
+        prev = self._filtered_rad
+        if prev is None or going_to_init:
+            self._filtered_rad = ref.copy()
+            return np.zeros(NUM_JOINTS)
+        if self.paused:
+            return np.zeros(NUM_JOINTS)
+        self._filtered_rad = filter_reference(self._mode, ref, prev, prev,
+                                              default_filter_config().filter_length)
+        return (self._filtered_rad - prev) / TICK_S
+
     def _feedforward_at(self, row: int) -> np.ndarray:
         """The feed-forward torques of 0-based ``row``, linear between sampled rows."""
         ff = self._feedforward

@@ -152,7 +152,8 @@ def simulate(trajectory_rad: np.ndarray, sidecar: PlanSidecar, ladder: LadderSpe
     rate = int(round(sidecar.rate_hz))
     player = TrajectoryPlayer(trajectory_rad, PlayerOptions(rate_hz=rate,
                                                             compliant_arms=compliant),
-                              schedule, sidecar.arm_feedforward)
+                              schedule, sidecar.arm_feedforward,
+                              {arm: sidecar.hand_holding(arm) for arm in ("left", "right")})
     controller = JointController(robot=robot)
     gains = opt.gains or default_drc_gains()
     monitor = VerdictMonitor(board, sidecar, T_err, player.time_of_line, opt.verdict)

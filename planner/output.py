@@ -30,6 +30,7 @@ from robot.plan_sidecar import (
     HoldRecord,
     PlanSidecar,
     Segment,
+    hand_holding_lines,
     sidecar_path,
     write_sidecar,
 )
@@ -354,12 +355,7 @@ def write_plan(result: SearchResult, planner: ClimbPlanner, out_traj: str | os.P
     distances = palm_rail_distances(timed.configs, kin, planner.geom)
     arm_modes = {}
     for side in ARMS:
-        limb = f"{side}_hand"
-        holding = np.zeros(timed.line_count, dtype=bool)
-        for s in segments:
-            h = s.holds.get(limb)
-            if h is not None and h.target.startswith("rail"):
-                holding[s.first_line - 1:s.last_line] = True
+        holding = hand_holding_lines(segments, timed.line_count, side)
         arm_modes[side] = arm_mode_runs(holding | (distances[side] <= PWM_RAIL_DISTANCE_M))
     feedforward = arm_feedforward(result, timed, after, planner.checker)
     metrics = _metrics(result, planner, timed, segments, clearance_every)

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import os
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -58,6 +59,16 @@ class Segment:
     moving_limbs: tuple[str, ...] = ()
 
 
+def hand_holding_lines(segments: Sequence[Segment], line_count: int, arm: str) -> np.ndarray:
+    """Lines on which the ``arm`` ("left"/"right") hand holds a rail, bool (line_count,)."""
+    held = np.zeros(line_count, dtype=bool)
+    for seg in segments:
+        hold = seg.holds.get(f"{arm}_hand")
+        if hold is not None and hold.target.startswith("rail"):
+            held[seg.first_line - 1:seg.last_line] = True
+    return held
+
+
 @dataclass(frozen=True, eq=False)
 class ArmFeedforward:
     """Joint torques the compliant arms must give so that the robot carries its load the
@@ -102,6 +113,10 @@ class PlanSidecar:
     planner_version: str = ""
     joint_order: tuple[str, ...] = JOINT_NAMES
     arm_feedforward: ArmFeedforward | None = None
+
+    def hand_holding(self, arm: str) -> np.ndarray:
+        """Lines on which the ``arm`` ("left"/"right") hand holds a rail, bool (line_count,)."""
+        return hand_holding_lines(self.segments, self.line_count, arm)
 
     def segment_at(self, line: int) -> Segment:
         for seg in self.segments:

@@ -322,17 +322,43 @@ def test_feedforward_is_interpolated_between_sampled_lines_for_pwm_joints_only()
     assert both.step(19 / 25).feedforward_nm[rsp] == pytest.approx(-19 / 4)  # line 20
 
 
-def test_feedforward_is_off_during_go_to_init_and_velocity_is_the_files():
-    ff = _feedforward(20, 4)
+def test_feedforward_is_off_during_go_to_init_and_velocity_is_the_filtered_references():
+    ff = _feedforward(200, 4)
     opts = PlayerOptions(go_to_init=True, compliant_arms={"left"})
-    p = TrajectoryPlayer(_ramp(20), opts, feedforward=ff)
+    p = TrajectoryPlayer(_ramp(200), opts, feedforward=ff)
     t = p.step(0.0, np.zeros(N))
     assert t.going_to_init and not t.feedforward_nm.any() and not t.velocity_rad_s.any()
-    t = p.step(3.0 + 2 / 25)  # line 3
-    assert t.feedforward_nm[JOINT_INDEX["LSP"]] == pytest.approx(0.5)
-    np.testing.assert_allclose(t.velocity_rad_s, 0.01 * 25)  # 0.01 rad per line at 25 Hz
-    t = p.step(100.0)
-    assert t.finished and not t.velocity_rad_s.any()
+    ticks = [p.step(3.0 + n * TICK_S) for n in range(120 * 8)]
+    assert ticks[2 * 8].line_number == 3
+    assert ticks[2 * 8].feedforward_nm[JOINT_INDEX["LSP"]] == pytest.approx(0.5)
+    # The daemon's filter (L = 40) smooths the 0.01 rad steps of each 25 Hz line: in steady
+    # state its velocity averages the file's 0.25 rad/s over a line, and it never jumps.
+    v = np.array([t.velocity_rad_s[0] for t in ticks])
+    assert v[100 * 8:101 * 8].mean() == pytest.approx(0.25, rel=1e-3)
+    assert np.abs(np.diff(v)).max() < 0.01 / 40 / TICK_S + 1e-9
+    p.pause(3.0 + 120 * 8 * TICK_S)
+    assert not p.step(3.0 + 121 * 8 * TICK_S).velocity_rad_s.any()
+
+
+def test_a_holding_pwm_arm_is_force_controlled_with_feedforward_only():
+    holding = {"left": np.arange(20) >= 7}  # the hand closes on its rail on line 8
+    p = TrajectoryPlayer(_ramp(20), schedule=SCHEDULE, feedforward=_feedforward(20, 4),
+                         holding=holding)
+    modes = {}
+    for n in range(20 * 8):
+        t = p.step(n * TICK_S)
+        modes[t.line_number] = t.mode
+    lsp, lwr, rsp = JOINT_INDEX["LSP"], JOINT_INDEX["LWR"], JOINT_INDEX["RSP"]
+    assert modes[6][lsp] == RefMode.FILTER  # PWM, hand not yet holding: tracks
+    assert modes[8][lsp] == RefMode.COMPLIANT and modes[12][lsp] == RefMode.COMPLIANT
+    assert modes[8][lwr] == RefMode.COMPLIANT  # no PWM, but its reference follows it
+    assert modes[8][rsp] == RefMode.FILTER  # the other arm is in position mode
+    assert modes[13][lsp] == RefMode.FILTER  # position mode again: never COMPLIANT
+    without = TrajectoryPlayer(_ramp(20), schedule=SCHEDULE, holding=holding)
+    assert all((without.step(n * TICK_S).mode == RefMode.FILTER).all()
+               for n in range(20 * 8))  # no feed-forward: every line as hubo-ach
+    with pytest.raises(ModeScheduleError, match="holding"):
+        TrajectoryPlayer(_ramp(20), holding={"left": np.ones(5, bool)})
 
 
 def test_feedforward_must_cover_the_file():
