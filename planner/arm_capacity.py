@@ -27,11 +27,16 @@ from robot.joints import ARM_JOINTS, JOINT_INDEX
 from robot.motors import DEFAULT_BATTERY_V, motor_table
 from robot.pwm_gains import safe_default_gain_table
 
-__all__ = ["ARM_STRATEGIES", "DEFAULT_ARM_STRATEGY", "compliant_torque_nm",
-           "gripping_sides", "gripping_torque_limits"]
+__all__ = ["ARM_STRATEGIES", "BACK_EMF_SHARE", "DEFAULT_ARM_STRATEGY",
+           "compliant_speed_rad_s", "compliant_torque_nm", "gripping_sides",
+           "gripping_torque_limits", "gripping_velocity_limits"]
 
 ARM_STRATEGIES = ("mixed", "position")
 DEFAULT_ARM_STRATEGY = "mixed"
+#: Share of a compliant joint's PWM clamp its back-EMF may take while it moves: a PWM arm
+#: on a rail is moved by the body at a speed its motor must follow, and the duty that
+#: overcomes the back-EMF is duty the arm's load cannot have.
+BACK_EMF_SHARE = 0.25
 
 
 @lru_cache(maxsize=16)
@@ -41,6 +46,36 @@ def compliant_torque_nm(battery_v: float = DEFAULT_BATTERY_V) -> Mapping[str, fl
     return MappingProxyType({
         name: float(per_duty[JOINT_INDEX[name]] * max_pwm)
         for name, (_, _, max_pwm) in safe_default_gain_table().items() if max_pwm > 0})
+
+
+@lru_cache(maxsize=16)
+def compliant_speed_rad_s(battery_v: float = DEFAULT_BATTERY_V) -> Mapping[str, float]:
+    """Speed at which a compliant joint's back-EMF takes `BACK_EMF_SHARE` of its PWM
+    clamp, ``share · τ_clamp / b`` (b: back-EMF damping, `robot.motors`) [rad/s]."""
+    damping = motor_table().back_emf_damping
+    return MappingProxyType({
+        name: BACK_EMF_SHARE * torque / float(damping[JOINT_INDEX[name]])
+        for name, torque in compliant_torque_nm(battery_v).items()})
+
+
+def gripping_velocity_limits(nominal_rad_s: np.ndarray, sides: Iterable[str],
+                             strategy: str = DEFAULT_ARM_STRATEGY,
+                             battery_v: float = DEFAULT_BATTERY_V) -> np.ndarray | None:
+    """Velocity limits (40,) [rad/s] while the arms of ``sides`` hold rails and
+    ``strategy`` drives them: the nominal ones, the compliant arms' joints capped at
+    `compliant_speed_rad_s`; None when nothing is capped."""
+    if strategy not in ARM_STRATEGIES:
+        raise ValueError(f"unknown arm strategy {strategy!r}; use one of {ARM_STRATEGIES}")
+    if strategy == "position" or not sides:
+        return None
+    limits = np.array(nominal_rad_s, dtype=float)
+    speed = compliant_speed_rad_s(battery_v)
+    for side in sides:
+        for name in ARM_JOINTS[side]:
+            if name in speed:
+                j = JOINT_INDEX[name]
+                limits[j] = min(limits[j], speed[name])
+    return limits
 
 
 def gripping_sides(limbs: Iterable[str]) -> frozenset[str]:

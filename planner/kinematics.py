@@ -10,9 +10,15 @@ import numpy as np
 import pinocchio as pin
 import placo
 
-from robot.joints import JOINT_NAMES
+from robot.joints import ARM_JOINTS, JOINT_NAMES
 from robot.params import RobotParams, robot_params
 from robot.urdf import robot_urdf
+
+
+#: The planner keeps the arm joints this far inside their limits [rad]: a compliant arm
+#: pressed on its mechanical stop is rigid in that direction, and the stop, not the
+#: planned torques, then decides what its hand carries.
+ARM_LIMIT_MARGIN_RAD = 0.05
 
 
 @dataclass
@@ -35,6 +41,11 @@ class HuboKinematics:
         params = robot_params(robot)
         wrapper = placo.RobotWrapper("", placo.Flags.ignore_collisions, robot_urdf(params))
         model = wrapper.model
+        for name in (n for side in ARM_JOINTS.values() for n in side):
+            if model.existJointName(name):
+                idx = model.joints[model.getJointId(name)].idx_q
+                wrapper.set_joint_limits(name, model.lowerPositionLimit[idx] + ARM_LIMIT_MARGIN_RAD,
+                                         model.upperPositionLimit[idx] - ARM_LIMIT_MARGIN_RAD)
         q_index = {model.names[j]: model.joints[j].idx_q for j in range(2, model.njoints)}
         index = np.array([q_index.get(name, -1) for name in JOINT_NAMES])
         return cls(params, wrapper, model, model.createData(), index, q_index)

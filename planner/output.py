@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from planner.arm_capacity import DEFAULT_ARM_STRATEGY
 from robot.joints import ARM_JOINTS
 from robot.plan_sidecar import (
     ArmFeedforward,
@@ -99,8 +100,8 @@ def step_groups(segments: Sequence[PathSegment]) -> list[list[int]]:
     return groups
 
 
-def segment_paths(result: SearchResult, kin, q_start: np.ndarray | None = None
-                  ) -> list[SegmentPath]:
+def segment_paths(result: SearchResult, kin, q_start: np.ndarray | None = None,
+                  arm_strategy: str = DEFAULT_ARM_STRATEGY) -> list[SegmentPath]:
     """The search segments as timing inputs: each path starts where the previous ended.
 
     Args:
@@ -108,11 +109,18 @@ def segment_paths(result: SearchResult, kin, q_start: np.ndarray | None = None
         kin: `HuboKinematics` (columns of a configuration).
         q_start: the configuration the plan starts from; the first segment's first
             configuration if None.
+        arm_strategy: how gripping arms are driven; under ``mixed`` a segment in which
+            a hand holds its rail, closes on it or opens, moves that arm no faster than
+            its compliant joints can follow (`planner.arm_capacity`).
 
     Returns:
         One `SegmentPath` per segment; the last segment of each step dwells after it.
     """
+    from planner.arm_capacity import gripping_sides, gripping_velocity_limits
     from planner.timing import SegmentPath
+    from robot.limits import joint_limits
+
+    nominal = joint_limits(kin.params.name).velocity_nominal_rad_s
 
     last_of_step = {g[-1] for g in step_groups(result.segments)}
     out: list[SegmentPath] = []
@@ -123,9 +131,14 @@ def segment_paths(result: SearchResult, kin, q_start: np.ndarray | None = None
             configs = [prev] + configs
         prev = configs[-1] if configs else prev
         q = np.array(configs)
+        on_rail = [h.limb for h in seg.holds]
+        if seg.phase in ("grasp", "release"):
+            on_rail += list(seg.moving_limbs)
         out.append(SegmentPath(f"{seg.step.label}/{seg.phase}",
                                np.array([kin.columns(c) for c in q]), q,
-                               dwell_after=i in last_of_step))
+                               dwell_after=i in last_of_step,
+                               velocity_max_rad_s=gripping_velocity_limits(
+                                   nominal, gripping_sides(on_rail), arm_strategy)))
     return out
 
 
@@ -345,7 +358,7 @@ def write_plan(result: SearchResult, planner: ClimbPlanner, out_traj: str | os.P
     kin = planner.kin
     if q_start is None:
         q_start = planner.start_configuration()[0]
-    paths = segment_paths(result, kin, q_start)
+    paths = segment_paths(result, kin, q_start, planner.config.arm_strategy)
     timed = time_parameterize(paths, joint_limits(kin.params.name),
                               TimingConfig(rate_hz=rate_hz, dwell_s=dwell_s),
                               kin.q_index_of_column)

@@ -104,12 +104,21 @@ class SegmentPath:
         configs: (M, nq) full configurations matching ``columns_rad`` (pinocchio layout:
             base xyz [m], base quaternion x y z w, joints [rad]), or None.
         dwell_after: hold the last line for ``dwell_s`` after this segment (end of a step).
+        velocity_max_rad_s: (40,) velocity limits of this segment [rad/s], below the
+            nominal ones (e.g. a compliant arm on its rail); the nominal ones when None.
     """
 
     label: str
     columns_rad: np.ndarray = field(repr=False)
     configs: np.ndarray | None = field(default=None, repr=False)
     dwell_after: bool = False
+    velocity_max_rad_s: np.ndarray | None = field(default=None, repr=False)
+
+    def velocity_limits(self, limits: JointLimits) -> np.ndarray:
+        """The velocity limits this segment is timed with [rad/s]."""
+        nominal = limits.velocity_nominal_rad_s
+        return nominal if self.velocity_max_rad_s is None else np.minimum(
+            nominal, self.velocity_max_rad_s)
 
 
 @dataclass
@@ -244,9 +253,11 @@ def _interpolate_configs(s_way: np.ndarray, configs: np.ndarray, s: np.ndarray) 
 
 
 def _check_samples(label: str, lines: np.ndarray, rate_hz: float, limits: JointLimits,
-                   tol: float) -> None:
-    """Finite-difference velocity and acceleration of sampled lines against the limits."""
-    for order, limit, verb, unit in ((1, limits.velocity_nominal_rad_s, "moves", "rad/s"),
+                   tol: float, velocity_max_rad_s: np.ndarray | None = None) -> None:
+    """Finite-difference velocity and acceleration of sampled lines against the limits
+    (``velocity_max_rad_s``: the segment's velocity limits; the nominal ones if None)."""
+    v_max = limits.velocity_nominal_rad_s if velocity_max_rad_s is None else velocity_max_rad_s
+    for order, limit, verb, unit in ((1, v_max, "moves", "rad/s"),
                                      (2, limits.accel_nominal_rad_s2, "accelerates", "rad/s²")):
         if len(lines) <= order:
             return
@@ -255,7 +266,7 @@ def _check_samples(label: str, lines: np.ndarray, rate_hz: float, limits: JointL
         if ratio.max() > 1.0 + tol:
             k, j = np.unravel_index(int(np.argmax(ratio)), ratio.shape)
             raise TimingError(f"segment {label}: sample {k + 1} {verb} {JOINT_NAMES[j]} at "
-                              f"{rate[k, j]:.4g} {unit}, above its nominal limit "
+                              f"{rate[k, j]:.4g} {unit}, above its limit "
                               f"{limit[j]:.4g} {unit}")
 
 
@@ -338,6 +349,7 @@ def _time_segment(seg: SegmentPath, limits: JointLimits, cfg: TimingConfig
         return None
     way = _smooth_path(cols[kept], PATH_SMOOTH_POINTS)
     scale, sub = cfg.limit_scale, cfg.grid_subdivision
+    v_max = seg.velocity_limits(limits)
     for attempt in range(cfg.retries + 1):
         traj = None
         # The spline runs through knots about KNOT_SPACING_RAD of path apart, not through
@@ -348,8 +360,7 @@ def _time_segment(seg: SegmentPath, limits: JointLimits, cfg: TimingConfig
         for spacing in KNOT_SPACING_RAD * np.array([1.0, 0.8, 2.0, 0.6, 1.4, 4.0, 0.4]):
             idx = _knot_indices(s_all[-1], len(way), spacing)
             for grid_sub in (sub, 1, 3):
-                traj = _toppra_trajectory(s_all[idx], way[idx],
-                                          scale * limits.velocity_nominal_rad_s,
+                traj = _toppra_trajectory(s_all[idx], way[idx], scale * v_max,
                                           scale * limits.accel_nominal_rad_s2, grid_sub)
                 if traj is not None:
                     break
@@ -359,8 +370,7 @@ def _time_segment(seg: SegmentPath, limits: JointLimits, cfg: TimingConfig
             log.info("%s: toppra found no parameterisation; timing it with a conservative "
                      "trapezoid", seg.label)
             idx = _knot_indices(s_all[-1], len(way), KNOT_SPACING_RAD)
-            traj = _TrapezoidTrajectory(s_all[idx], way[idx],
-                                        scale * limits.velocity_nominal_rad_s,
+            traj = _TrapezoidTrajectory(s_all[idx], way[idx], scale * v_max,
                                         scale * limits.accel_nominal_rad_s2)
         duration = float(traj.duration)
         n = max(1, math.ceil(duration * cfg.rate_hz - 1e-9))
@@ -373,7 +383,7 @@ def _time_segment(seg: SegmentPath, limits: JointLimits, cfg: TimingConfig
         lines[0], lines[-1] = way[0], way[-1]  # exact ends: segments join bit for bit
         lines = _limit_positions(lines, limits)
         try:
-            _check_samples(seg.label, lines, cfg.rate_hz, limits, cfg.tolerance)
+            _check_samples(seg.label, lines, cfg.rate_hz, limits, cfg.tolerance, v_max)
             break
         except TimingError as exc:
             if attempt == cfg.retries:
@@ -415,7 +425,8 @@ def _time_segment_at_corners(seg: SegmentPath, limits: JointLimits, cfg: TimingC
     for k, (a, b) in enumerate(zip(cuts[:-1], cuts[1:], strict=True)):
         piece = SegmentPath(f"{seg.label}#{k}", cols[a:b + 1],
                             None if seg.configs is None else
-                            np.asarray(seg.configs, dtype=float)[a:b + 1], False)
+                            np.asarray(seg.configs, dtype=float)[a:b + 1], False,
+                            seg.velocity_max_rad_s)
         timed = _time_segment(piece, limits, cfg)
         if timed is None:
             continue

@@ -4,11 +4,19 @@ import numpy as np
 import pytest
 
 from ladders.loader import load_ladder
-from planner.arm_capacity import compliant_torque_nm, gripping_torque_limits
+from planner.arm_capacity import (
+    BACK_EMF_SHARE,
+    compliant_speed_rad_s,
+    compliant_torque_nm,
+    gripping_torque_limits,
+    gripping_velocity_limits,
+)
+from planner.kinematics import ARM_LIMIT_MARGIN_RAD, HuboKinematics
 from planner.search import ClimbPlanner, PlannerConfig, StepStats
 from planner.stability import torque_feasibility, torque_limits_by_joint
 from primitives.library import climb_sequence
-from robot.joints import ARM_JOINTS
+from robot.joints import ARM_JOINTS, JOINT_INDEX
+from robot.limits import joint_limits
 
 
 def _stall_nm(kt, r_ohm, gear, duty_pct, volts=48.0, eta=0.7):
@@ -44,6 +52,43 @@ def test_only_the_gripping_arm_is_limited_and_only_under_mixed():
     assert gripping_torque_limits(rigid, {"left", "right"}, "position") == rigid
     with pytest.raises(ValueError, match="arm strategy"):
         gripping_torque_limits(rigid, {"left"}, "limp")
+
+
+def test_compliant_speed_leaves_the_load_three_quarters_of_the_clamp():
+    # Back-EMF damping b = η·gear²·Kt²/R (Ke = Kt in SI): a shoulder RE35 on a 250:1 gear.
+    b_shoulder = 0.7 * 250**2 * 0.060**2 / 2.8
+    speed = compliant_speed_rad_s()
+    assert speed["LSP"] == pytest.approx(BACK_EMF_SHARE * compliant_torque_nm()["LSP"]
+                                         / b_shoulder, rel=1e-9)
+    assert speed["LSP"] == pytest.approx(0.063, abs=1e-3)  # rad/s, against 1 nominal
+    assert "LWR" not in speed  # the wrist roll is never compliant
+
+
+def test_velocity_limits_cap_only_the_compliant_joints_of_holding_arms():
+    nominal = joint_limits("drc-hubo").velocity_nominal_rad_s
+    capped = gripping_velocity_limits(nominal, {"right"}, "mixed")
+    speed = compliant_speed_rad_s()
+    for name in ARM_JOINTS["right"]:
+        j = JOINT_INDEX[name]
+        assert capped[j] == (min(nominal[j], speed[name]) if name in speed else nominal[j])
+    untouched = [JOINT_INDEX[n] for n in ARM_JOINTS["left"] + ("RKN", "WST")]
+    np.testing.assert_array_equal(capped[untouched], nominal[untouched])
+    assert gripping_velocity_limits(nominal, {"left", "right"}, "position") is None
+    assert gripping_velocity_limits(nominal, set(), "mixed") is None
+
+
+def test_the_planner_keeps_the_arms_off_their_stops():
+    kin = HuboKinematics.load()
+    limits = joint_limits("drc-hubo")
+    for name in ARM_JOINTS["left"] + ARM_JOINTS["right"]:
+        i, j = kin.q_index[name], JOINT_INDEX[name]
+        assert kin.model.lowerPositionLimit[i] == pytest.approx(
+            limits.lower_rad[j] + ARM_LIMIT_MARGIN_RAD)
+        assert kin.model.upperPositionLimit[i] == pytest.approx(
+            limits.upper_rad[j] - ARM_LIMIT_MARGIN_RAD)
+    knee = kin.q_index["LKN"]
+    assert kin.model.lowerPositionLimit[knee] == pytest.approx(
+        limits.lower_rad[JOINT_INDEX["LKN"]])
 
 
 @pytest.fixture(scope="module")

@@ -163,11 +163,11 @@ def test_samples_breaking_a_limit_are_timed_again_then_refused(monkeypatch):
     calls = []
     real = timing._check_samples
 
-    def strict(label, lines, rate_hz, limits, tol):
+    def strict(label, lines, rate_hz, limits, tol, v_max=None):
         calls.append(len(lines))
         if len(calls) < 3:
             raise TimingError("too fast")
-        real(label, lines, rate_hz, limits, tol)
+        real(label, lines, rate_hz, limits, tol, v_max)
 
     monkeypatch.setattr(timing, "_check_samples", strict)
     seg = _ramp("s", np.zeros(40), "WST", 0.2, 6)
@@ -209,3 +209,17 @@ def test_limit_smoothing_is_a_convex_blend_with_exact_ends():
     np.testing.assert_array_equal(out[[0, -1], k], np.clip(lines[[0, -1], k],
                                                            LIMITS.lower_rad[k], None))
     np.testing.assert_array_equal(np.delete(out, k, axis=1), np.delete(lines, k, axis=1))
+
+
+def test_a_segment_velocity_limit_slows_only_that_segment():
+    start = np.zeros(40)
+    fast = time_parameterize([_ramp("free", start, "LSP", 0.3, 30)], LIMITS,
+                             TimingConfig(rate_hz=RATE_HZ))
+    cap = LIMITS.velocity_nominal_rad_s.copy()
+    cap[JOINT_INDEX["LSP"]] = 0.05
+    held = _ramp("held", start, "LSP", 0.3, 30)
+    held.velocity_max_rad_s = cap
+    slow = time_parameterize([held], LIMITS, TimingConfig(rate_hz=RATE_HZ))
+    vel = np.abs(np.diff(slow.columns_rad[:, JOINT_INDEX["LSP"]])) * RATE_HZ
+    assert vel.max() <= 0.05 * (1 + 1e-6)
+    assert slow.duration_s >= 0.3 / 0.05 > 2 * fast.duration_s
