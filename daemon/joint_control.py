@@ -207,7 +207,7 @@ class JointController:
         pos_rad: np.ndarray,
         vel_rad_s: np.ndarray,
         gains: PwmGains,
-        pwm_command_pct: np.ndarray | None = None,
+        feedforward_pct: np.ndarray | None = None,
     ) -> ControlOutput:
         """Runs one 5 ms tick of the control law.
 
@@ -218,9 +218,9 @@ class JointController:
             pos_rad: measured position [rad], shape (40,).
             vel_rad_s: measured velocity [rad/s], shape (40,).
             gains: validated PWM gains.
-            pwm_command_pct: this tick's feed-forward duty [%], shape (40,), within
-                ``±PWM_COMMAND_LIMIT_PCT``, replacing ``gains.pwm_command_pct`` (the
-                player's per-line feed-forward); None keeps the gains'.
+            feedforward_pct: the player's feed-forward duty for this tick [%], shape
+                (40,), within ``±PWM_COMMAND_LIMIT_PCT``, added to the gains' constant
+                ``pwm_command_pct`` (the sum is clipped to that limit too).
 
         Returns:
             The references, duties and flags to send this tick.
@@ -234,13 +234,16 @@ class JointController:
         comply = _vector("comply_mask", comply_mask, bool)
         pos = _vector("pos_rad", pos_rad)
         vel = _vector("vel_rad_s", vel_rad_s)
-        if pwm_command_pct is not None:
-            pwm_command_pct = _vector("pwm_command_pct", pwm_command_pct)
-            bad = np.abs(pwm_command_pct) > PWM_COMMAND_LIMIT_PCT
+        command = gains.pwm_command_pct
+        if feedforward_pct is not None:
+            feedforward = _vector("feedforward_pct", feedforward_pct)
+            bad = np.abs(feedforward) > PWM_COMMAND_LIMIT_PCT
             if bad.any():
                 names = ", ".join(JOINT_NAMES[i] for i in np.flatnonzero(bad))
-                raise ControlInputError(f"pwm_command_pct of {names} is outside "
+                raise ControlInputError(f"feedforward_pct of {names} is outside "
                                         f"±{PWM_COMMAND_LIMIT_PCT:g} %")
+            command = np.clip(command + feedforward, -PWM_COMMAND_LIMIT_PCT,
+                              PWM_COMMAND_LIMIT_PCT)
         if self._sent_rad is None:
             self.reset(pos)
         lower, upper = self.limits.lower_rad, self.limits.upper_rad
@@ -260,7 +263,7 @@ class JointController:
         sent = np.where(leaving, pos, sent)  # first tick out of PWM starts from the encoder
         sent, sent_clamped = clamp_reference(sent, lower, upper)
 
-        duty, saturated = pwm_duty(sent, pos, vel, gains, pwm_command_pct)
+        duty, saturated = pwm_duty(sent, pos, vel, gains, command)
         duty = np.where(want_pwm, duty, 0.0)
         saturated &= want_pwm
         limp = want_pwm & (((gains.kp == 0) & (gains.kd == 0)) | (gains.max_pwm_pct == 0))

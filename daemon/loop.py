@@ -65,6 +65,7 @@ from daemon.structs import (
 )
 from robot.errors import InputError
 from robot.joints import JOINT_INDEX, JOINT_NAMES, NECK_AND_WAIST, NUM_JOINTS
+from robot.pwm_gains import PWM_COMMAND_LIMIT_PCT
 
 __all__ = [
     "Backend",
@@ -404,7 +405,7 @@ class DaemonLoop:
         sensors = self.backend.read_sensors()
         self.last_sensors = sensors
         self._poll_commands(now_s)
-        ref, mode, comply, playing, age_s = self._reference(start_ns)
+        ref, mode, comply, feedforward, playing, age_s = self._reference(start_ns)
         prev = self.controller.ref_sent_rad
         if prev is None:
             prev = sensors.pos_rad.copy()
@@ -421,6 +422,7 @@ class DaemonLoop:
             ref = prev.copy()
             mode = np.full(NUM_JOINTS, RefMode.DIRECT, np.int8)
             comply = self._last_comply.copy() if watchdog else np.zeros(NUM_JOINTS, bool)
+            feedforward = None
         else:
             self._last_comply = comply.copy()
         gated = ~self.zeroed | (now_s < self._ignore_until_s) | self.control_off
@@ -431,8 +433,10 @@ class DaemonLoop:
             ref = np.where(gated, self._hold_ref, ref)
             mode = np.where(gated, RefMode.DIRECT, mode).astype(np.int8)
             comply = comply & ~gated
+            if feedforward is not None:
+                feedforward = np.where(gated, 0.0, feedforward)
         out = self.controller.tick(ref, mode, comply, sensors.pos_rad, sensors.vel_rad_s,
-                                   self.gains)
+                                   self.gains, feedforward)
         self.backend.write_commands(BoardCommands.from_output(out, self.control_off))
         self._publish(start_ns, late_ns, now_s, sensors, out, ref, mode, comply, gated,
                       watchdog, playing, age_s)
@@ -488,22 +492,26 @@ class DaemonLoop:
 
     # ------------------------------------------------------------------ inputs
     def _reference(self, now_ns: int):
-        """(ref, mode, comply, playing, age_s) of the newest valid ``ref`` sample.
+        """(ref, mode, comply, feed-forward, playing, age_s) of the newest valid ``ref``
+        sample; the feed-forward duty [%] only on the joints it asks to comply.
 
         ``ref`` is None when there is no usable sample (none since start-up, or refused).
         """
         s = self.channels.ref.read_latest()
         if s is None or int(s["time_ns"]) < self._t0_ns:
-            return None, None, None, False, float("inf")
+            return None, None, None, None, False, float("inf")
         age_s = (now_ns - int(s["time_ns"])) * 1e-9
         ref = np.array(s["ref"], dtype=float)
         mode = np.array(s["mode"], dtype=np.int8)
         comply = np.array(s["comply"], dtype=bool)
+        command = np.array(s["pwm_command"], dtype=float)
         neck = self.channels.ref_neck.read_latest()
         if neck is not None and int(neck["time_ns"]) >= self._t0_ns:
             ref[NECK_JOINTS] = neck["ref"][NECK_JOINTS]
             mode[NECK_JOINTS] = neck["mode"][NECK_JOINTS]
             comply[NECK_JOINTS] = neck["comply"][NECK_JOINTS]
+            command[NECK_JOINTS] = neck["pwm_command"][NECK_JOINTS]
+        feedforward = np.where(comply, command, 0.0)
         problem = None
         if not np.isfinite(ref).all():
             bad = np.flatnonzero(~np.isfinite(ref))
@@ -511,13 +519,17 @@ class DaemonLoop:
         elif not np.isin(mode, _MODES).all():
             bad = np.flatnonzero(~np.isin(mode, _MODES))
             problem = f"reference mode outside 0..3 for {', '.join(JOINT_NAMES[i] for i in bad)}"
+        elif not (np.abs(feedforward) <= PWM_COMMAND_LIMIT_PCT).all():
+            bad = np.flatnonzero(~(np.abs(feedforward) <= PWM_COMMAND_LIMIT_PCT))
+            problem = (f"feed-forward duty outside ±{PWM_COMMAND_LIMIT_PCT:g} % for "
+                       f"{', '.join(JOINT_NAMES[i] for i in bad)}")
         if problem is not None:
             if int(s["time_ns"]) != self._bad_ref_ns:
                 self._bad_ref_ns = int(s["time_ns"])
                 log.error("ref sample from writer %d refused (%s); holding",
                           int(s["writer_id"]), problem)
-            return None, None, None, bool(s["playing"]), age_s
-        return ref, mode, comply, bool(s["playing"]), age_s
+            return None, None, None, None, bool(s["playing"]), age_s
+        return ref, mode, comply, feedforward, bool(s["playing"]), age_s
 
     def _poll_commands(self, now_s: float) -> None:
         c = self.channels.board_cmd.read_latest()

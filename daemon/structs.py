@@ -20,8 +20,8 @@ Sizes (bytes, checked by the tests):
 
 | channel | dtype | size |
 |---|---|---|
-| ``ref`` | `REF_DTYPE` | 421 |
-| ``ref-neck`` | `REF_DTYPE` (only the neck entries are used) | 421 |
+| ``ref`` | `REF_DTYPE` | 741 |
+| ``ref-neck`` | `REF_DTYPE` (only the neck entries are used) | 741 |
 | ``board-cmd`` | `BOARD_CMD_DTYPE` | 76 |
 | ``pwm-gains`` | `PWM_GAINS_DTYPE` | 1300 |
 | ``state`` | `STATE_DTYPE` | 2188 |
@@ -93,7 +93,9 @@ HEADER_FIELDS: list[tuple] = [
     ("time_ns", "<i8"),
 ]
 
-#: ``ref`` and ``ref-neck``: what the player wants. 421 bytes.
+#: ``ref`` and ``ref-neck``: what the player wants. 741 bytes. ``pwm_command`` is the
+#: player's feed-forward duty of this tick (a compliant arm's planned load); the daemon
+#: adds it to the ``pwm-gains`` constant ``pwm_command`` of the joints it asks to comply.
 REF_DTYPE = np.dtype(
     HEADER_FIELDS
     + [
@@ -101,6 +103,7 @@ REF_DTYPE = np.dtype(
         ("ref", "<f8", (NUM_JOINTS,)),  # [rad]
         ("mode", "u1", (NUM_JOINTS,)),  # RefMode
         ("comply", "u1", (NUM_JOINTS,)),  # 1 = PWM (compliant) mode
+        ("pwm_command", "<f8", (NUM_JOINTS,)),  # [%] feed-forward duty, compliant joints
     ],
     align=False,
 )

@@ -5,9 +5,11 @@
 
 Before anything is sent, the whole file is checked (`robot.trajectory_file`): a bad file
 exits 2 naming ``FILE:LINE:COLUMN``, and the ``ref`` channel is never written. The
-sidecar ``FILE.plan.json``, when present, gives the rate (unless ``-f``) and the per-arm
-position/PWM schedule (unless ``--no-auto-modes``); ``-c``, ``-cl``, ``-cr`` force an arm
-compliant for the whole file.
+sidecar ``FILE.plan.json``, when present, gives the rate (unless ``-f``), the per-arm
+position/PWM schedule and the compliant arms' feed-forward (unless ``--no-auto-modes``);
+``-c``, ``-cl``, ``-cr`` force an arm compliant for the whole file. The feed-forward
+torques go out as each ``ref`` sample's ``pwm_command`` duty, at the battery voltage the
+daemon reports (as ``validate-plan`` plays them).
 
 Then it waits for a running ``hubo-daemon`` on ``--instance`` (its ``state`` channel
 ticking), refuses joints that are not homed, waits for a homing in progress to end, and
@@ -72,7 +74,8 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("-line", dest="line", type=int, default=1, metavar="N",
                    help="start at 1-based line N")
     p.add_argument("--no-auto-modes", action="store_true",
-                   help="ignore the sidecar's per-arm position/PWM schedule")
+                   help="ignore the sidecar's per-arm position/PWM schedule and "
+                        "feed-forward")
     p.add_argument("--instance", default="default", help="daemon instance (default)")
     p.add_argument("--robot", default=None, help="robot (default: the sidecar's or drc-hubo)")
     p.add_argument("--init-s", type=float, default=3.0, metavar="S",
@@ -105,13 +108,17 @@ def _load(args):
     if sidecar and len(traj) != sidecar.line_count:
         raise InputError(f"{path}:{len(traj)}: the file has {len(traj)} lines, its sidecar "
                          f"{side} says {sidecar.line_count}")
-    schedule = sidecar.arm_modes if sidecar and not args.no_auto_modes else None
+    auto = sidecar is not None and not args.no_auto_modes
+    schedule = sidecar.arm_modes if auto else None
     opts = PlayerOptions(rate_hz=rate, go_to_init=args.init, go_to_init_s=args.init_s,
                          compliant_arms=compliant_arms_from_flags(args.c, args.cl, args.cr),
                          no_filter=args.no_filter, start_line=args.line)
     if not (np.isfinite(args.line_tolerance) and args.line_tolerance > 0):
         raise InputError(f"--line-tolerance {args.line_tolerance}: must be > 0 [rad]")
-    return traj, TrajectoryPlayer(traj, opts, schedule), sidecar is not None and schedule
+    player = TrajectoryPlayer(
+        traj, opts, schedule, sidecar.arm_feedforward if auto else None,
+        {arm: sidecar.hand_holding(arm) for arm in ("left", "right")} if auto else None)
+    return traj, player, auto
 
 
 def _wait_for_daemon(state, instance: str) -> np.ndarray:
@@ -181,7 +188,9 @@ class _Keys:
 def _play(args, traj, player, auto) -> int:
     from daemon.channels import open_channel
     from daemon.loop import sleep_until_ns
+    from daemon.pwm import feedforward_duty_pct
     from daemon.structs import REF_DTYPE, new_sample
+    from robot.motors import DEFAULT_BATTERY_V, motor_table
 
     ref = open_channel("ref", args.instance)
     state = open_channel("state", args.instance)
@@ -206,6 +215,7 @@ def _play(args, traj, player, auto) -> int:
                 keys = _Keys()
         sample = new_sample(REF_DTYPE)
         sample["playing"] = 1
+        motors = motor_table()
         n = player.num_lines
         if not args.quiet:
             modes = "sidecar arm modes" if auto else "no sidecar arm modes"
@@ -222,7 +232,8 @@ def _play(args, traj, player, auto) -> int:
                 flags["toggles"] += keys.presses()
             if flags["stop"]:
                 break
-            pos = np.asarray(state.read_latest()["pos"]) if not player.started else None
+            latest = state.read_latest()
+            pos = np.asarray(latest["pos"]) if not player.started else None
             if player.started:
                 while flags["toggles"]:
                     flags["toggles"] -= 1
@@ -231,6 +242,11 @@ def _play(args, traj, player, auto) -> int:
             sample["ref"] = tick.ref_rad
             sample["mode"] = tick.mode
             sample["comply"] = tick.comply
+            if player.has_feedforward:
+                volts = float(latest["power"]["V"])
+                sample["pwm_command"] = feedforward_duty_pct(
+                    tick.feedforward_nm, volts if volts > 0 else DEFAULT_BATTERY_V,
+                    tick.velocity_rad_s, motors)
             if tick.finished:
                 sample["playing"] = 0
             ref.write(sample)

@@ -415,6 +415,11 @@ class TrajectoryPlayer:
 
     # ----------------------------------------------------------------- schedule
     @property
+    def has_feedforward(self) -> bool:
+        """Whether ticks carry the sidecar's arm feed-forward."""
+        return self._feedforward is not None
+
+    @property
     def num_lines(self) -> int:
         """Lines in the trajectory."""
         return self.trajectory_rad.shape[0]

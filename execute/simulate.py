@@ -185,7 +185,7 @@ def simulate(trajectory_rad: np.ndarray, sidecar: PlanSidecar, ladder: LadderSpe
         vel_now = board.joint_vel()
         tick = player.step(now, pos_now)
         line_index = tick.line_index
-        feedforward = None if sidecar.arm_feedforward is None else feedforward_duty_pct(
+        feedforward = None if not player.has_feedforward else feedforward_duty_pct(
             tick.feedforward_nm, opt.board.battery_v, tick.velocity_rad_s, board.motors)
         out = controller.tick(tick.ref_rad, tick.mode, tick.comply, pos_now, vel_now, gains,
                               feedforward)

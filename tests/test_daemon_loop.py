@@ -288,3 +288,21 @@ def test_state_log_is_written_every_tick(tmp_path):
     with open(path, "ab") as f:
         f.write(b"\0" * 100)  # a partial record from a kill mid-write
     assert len(read_state_log(path)) == 25
+
+
+def test_the_players_feed_forward_adds_to_compliant_joints_only_and_is_bounded():
+    be = FakeBackend()
+    loop, w = _loop(be)
+    s = _ref(playing=0)
+    s["comply"][LSP] = 1
+    s["pwm_command"][LSP] = 2.0
+    s["pwm_command"][JOINT_INDEX["RSP"]] = 3.0  # not compliant: ignored
+    w.ref.write(s)
+    loop.run(max_ticks=5)
+    # On its reference a compliant joint's duty is −pwm_command (hubo-ach sign).
+    assert be.sent[-1].duty_pct[LSP] == pytest.approx(-2.0)
+    assert be.sent[-1].duty_pct[JOINT_INDEX["RSP"]] == 0.0
+    s["pwm_command"][LSP] = np.nan  # refused whole: the last good reference holds
+    w.ref.write(s)
+    loop.run(max_ticks=10)
+    assert be.sent[-1].duty_pct[LSP] == 0.0 and not be.sent[-1].pwm[LSP]

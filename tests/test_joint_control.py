@@ -175,17 +175,17 @@ def test_bad_inputs_are_refused_without_changing_state():
     np.testing.assert_array_equal(c.ref_sent_rad, ZERO)
 
 
-def test_tick_feedforward_replaces_the_gains_command_and_is_bounded():
+def test_tick_feedforward_adds_to_the_gains_command_and_is_bounded():
     c = JointController()
     gains = default_drc_gains().with_joint("LSP", pwm_command_pct=1.0)
     command = np.zeros(N)
     command[J["LSP"]] = -2.5
     out = c.tick(ZERO, RefMode.FILTER, _comply("LSP"), ZERO, ZERO, gains, command)
-    assert out.duty_pct[J["LSP"]] == pytest.approx(2.5)  # −(0 − 0 + (−2.5)); gains' 1.0 unused
+    assert out.duty_pct[J["LSP"]] == pytest.approx(1.5)  # −(0 − 0 + (1.0 − 2.5))
     out = c.tick(ZERO, RefMode.FILTER, _comply("LSP"), ZERO, ZERO, gains)
     assert out.duty_pct[J["LSP"]] == pytest.approx(-1.0)  # without it, the gains' command
     sent = c.ref_sent_rad
     command[J["LEB"]] = 150.0
-    with pytest.raises(ControlInputError, match="pwm_command_pct of LEB is outside"):
+    with pytest.raises(ControlInputError, match="feedforward_pct of LEB is outside"):
         c.tick(ZERO, RefMode.FILTER, _comply("LSP"), ZERO, ZERO, gains, command)
     np.testing.assert_array_equal(c.ref_sent_rad, sent)

@@ -21,7 +21,7 @@ from daemon.structs import (
 
 @pytest.mark.parametrize(
     "dtype,size",
-    [(REF_DTYPE, 421), (BOARD_CMD_DTYPE, 76), (PWM_GAINS_DTYPE, 1300), (STATE_DTYPE, 2188)],
+    [(REF_DTYPE, 741), (BOARD_CMD_DTYPE, 76), (PWM_GAINS_DTYPE, 1300), (STATE_DTYPE, 2188)],
 )
 def test_sizes_match_the_docstring(dtype, size):
     assert dtype.itemsize == size
