@@ -1,6 +1,6 @@
 """Benchmark: write → blocked-reader-wakes latency of `daemon.channels.ShmChannel`.
 
-Two separate processes: a writer writes a ``ref`` sample (421 B) every ~0.5 ms; a reader
+Two separate processes: a writer writes a ``ref`` sample (741 B) every ~0.5 ms; a reader
 sits in `wait_newer` and, on waking, takes ``CLOCK_MONOTONIC`` minus the sample's
 ``time_ns`` stamp (stamped at the start of `write`, so the copy is included).
 
@@ -226,20 +226,22 @@ def measure_latency(n: int = 3000, period_s: float = 0.0005, mechanism: str = "s
 
 def run() -> list[dict]:
     """Figures: median and p99 write→wake latency between two processes [µs]."""
+    from daemon.structs import REF_DTYPE
+
     lat = measure_latency()
     med, p99 = float(np.median(lat)), float(np.percentile(lat, 99))
     log.info("channel latency over %d samples: median %.1f µs, p99 %.1f µs", lat.size, med, p99)
     floor = measure_latency(mechanism="raw")
     figures = [
         {
-            "name": "channel write→wake latency, median (2 processes, 421 B)",
+            "name": f"channel write→wake latency, median (2 processes, {REF_DTYPE.itemsize} B)",
             "value": round(med, 2),
             "unit": "µs",
             "target": MEDIAN_TARGET_US,
             "ok": med <= MEDIAN_TARGET_US,
         },
         {
-            "name": "channel write→wake latency, p99 (2 processes, 421 B)",
+            "name": f"channel write→wake latency, p99 (2 processes, {REF_DTYPE.itemsize} B)",
             "value": round(p99, 2),
             "unit": "µs",
             "target": P99_TARGET_US,

@@ -34,7 +34,8 @@ Two implementations behind the one interface:
 
 Why not iceoryx2 (0.10.0, the maintained IPC library the issue suggested)? Measured with
 ``bench/bench_channels.py`` on the project VM (2 cores, with other jobs using one or both),
-two processes, the 421-byte ``ref`` struct, write → blocked reader wakes, median / p99:
+two processes, the ``ref`` struct (421 bytes then, 741 now), write → blocked reader wakes,
+median / p99:
 
 | mechanism | quieter run | busier run |
 |---|---|---|
