@@ -69,6 +69,27 @@ def rail_point(geom: LadderGeometry, side: str, rung: int, along_m: float = 0.0)
     return p0 + s_m * geom.ladder_direction
 
 
+def shoulder_room_along_m(geom: LadderGeometry, params: RobotParams, rung: int,
+                          torso_along_m: float) -> float:
+    """Along-rail offset from the point above rung ``rung`` [m] where a rail hold is an upper
+    arm's length, horizontally, from the shoulder of a torso standing ``torso_along_m``
+    up-ladder of the rung's tread centre; −inf if the rails are that far aside anyway.
+
+    A hand held nearer than that leaves the elbow no room but folded to its limit, where a
+    compliant arm carries nothing: on the ship ladder (rails 0.79 m apart, 0.17 m outside
+    the shoulders) a mount hold beside the shoulders folded both elbows to −2.65 rad and the
+    floor foot's lift-off was found in 1 of 6 searches (0.99 of the torque limits), against
+    6 of 6 (0.90) with it 0.2–0.3 m up the rail.
+    """
+    spec = geom.spec
+    aside_m = spec.rail_spacing_m / 2 - params.half_shoulder_width_m
+    ahead_sq_m2 = params.upper_arm_m ** 2 - aside_m ** 2
+    if ahead_sq_m2 <= 0:
+        return -np.inf
+    # Rail points above rung k and the rung's tread centre share x_L; d x_L / d along = cos.
+    return float((torso_along_m + np.sqrt(ahead_sq_m2)) / np.cos(spec.slope_rad))
+
+
 def sole_contact_points(params: RobotParams, T_world_sole: np.ndarray,
                         x_range_m: tuple[float, float]) -> np.ndarray:
     """Four corners of the sole part between ``x_range_m`` (sole frame x) [m], world."""
@@ -106,7 +127,11 @@ def make_hold(seed: HoldSeed, geom: LadderGeometry, params: RobotParams,
         pts = sole_contact_points(params, T, (x0, x1))
         return Hold(seed.limb, seed.target, T, pts, np.tile(up, (4, 1)), mu)
     if isinstance(seed, RailSeed):
-        p = rail_point(geom, seed.side, seed.rung, seed.along_m + offset_m[0])
+        along = seed.along_m
+        if seed.torso_along_m is not None:
+            along = max(along, shoulder_room_along_m(geom, params, seed.rung,
+                                                     seed.torso_along_m))
+        p = rail_point(geom, seed.side, seed.rung, along + offset_m[0])
         T = _pose(palm_rotation(geom, seed.side, p, shoulder_m, grip_style), p)
         # Thesis hand hold: a contact pushing up and one pulling the hand towards the ladder.
         towards_ladder = geom.R_world_ladder @ np.array([1.0, 0.0, 0.0])

@@ -47,12 +47,19 @@ class RungSeed:
 class RailSeed:
     """A palm closed on the ``side`` rail, at the rail point vertically above rung ``rung``
     (``rung`` may be one past the top rung: the rail extends that far), shifted
-    ``along_m`` up the rail."""
+    ``along_m`` up the rail.
+
+    With ``torso_along_m`` (the torso's place over rung ``rung``, up-ladder of its tread
+    centre [m]) the hold moves further up the rail if it would be nearer that torso's
+    shoulder than the arm needs (`planner.holds.shoulder_room_along_m`): close rails put
+    the hand beside the shoulder.
+    """
 
     limb: str
     side: str
     rung: int
     along_m: float = 0.0
+    torso_along_m: float | None = None
 
     @property
     def target(self) -> str:
@@ -68,9 +75,12 @@ def foot_on_rung(limb: str, rung: int) -> RungSeed:
 
 
 #: Where the hands first take the rails from the floor, along the rail from the point
-#: above rung 0 [m]: lower and nearer, within reach of a robot standing on the floor.
+#: above rung 0 [m]: lower and nearer, within reach of a robot standing on the floor,
+#: unless that is too near the shoulders once the body stands over rung 0 (`RailSeed`).
 MOUNT_ALONG_RAIL_M = -0.2
 
 
-def hand_on_rail(limb: str, rung: int, along_m: float = 0.0) -> RailSeed:
-    return RailSeed(limb, "left" if limb == "left_hand" else "right", rung, along_m)
+def hand_on_rail(limb: str, rung: int, along_m: float = 0.0,
+                 torso_along_m: float | None = None) -> RailSeed:
+    return RailSeed(limb, "left" if limb == "left_hand" else "right", rung, along_m,
+                    torso_along_m)

@@ -8,7 +8,7 @@ both hands move to the rail above rung k+1.
 
 from __future__ import annotations
 
-from primitives.hold_seeds import MOUNT_ALONG_RAIL_M, foot_on_rung, hand_on_rail
+from primitives.hold_seeds import FOOT_ALONG_M, MOUNT_ALONG_RAIL_M, foot_on_rung, hand_on_rail
 from primitives.primitive import LimbWaypoints, Primitive, Step
 
 # Seed postures [rad]: arms reaching forward and out to the rails with bent elbows and
@@ -39,6 +39,11 @@ MOVE_R_FOOT = Primitive("moveRFoot", ("right_foot",), _ARMS)
 #: Straighten the legs with every hold kept: the body rises over the new rung.
 STRAIGHTEN = Primitive("straighten", (), {**_ARMS, **_STAND}, pelvis_offset_m=(-0.2, 0.0, 0.85))
 
+#: Where the torso stands over rung 0 at the end of the mount (placeRFoot's pelvis seed,
+#: over the rung foot), up-ladder of the rung's tread centre [m]: the hands' mount holds
+#: must leave the arms room from there.
+MOUNT_TORSO_ALONG_M = FOOT_ALONG_M + PLACE_R_FOOT.pelvis_offset_m[0]
+
 PRIMITIVES = {p.name: p for p in (PLACE_HANDS, PLACE_L_FOOT, PLACE_R_FOOT, MOVE_L_HAND,
                                   MOVE_R_HAND, MOVE_L_FOOT, MOVE_R_FOOT, STRAIGHTEN)}
 
@@ -48,8 +53,8 @@ def climb_sequence(top_rung: int) -> list[Step]:
     if top_rung < 0:
         raise ValueError(f"top rung must be ≥ 0, got {top_rung}")
     steps = [
-        Step(PLACE_HANDS, (hand_on_rail("left_hand", 0, MOUNT_ALONG_RAIL_M),
-                           hand_on_rail("right_hand", 0, MOUNT_ALONG_RAIL_M)), 0),
+        Step(PLACE_HANDS, tuple(hand_on_rail(limb, 0, MOUNT_ALONG_RAIL_M, MOUNT_TORSO_ALONG_M)
+                                for limb in ("left_hand", "right_hand")), 0),
         Step(PLACE_L_FOOT, (foot_on_rung("left_foot", 0),), 0),
         Step(PLACE_R_FOOT, (foot_on_rung("right_foot", 0),), 0),
         Step(STRAIGHTEN, (), 0),

@@ -176,3 +176,27 @@ def test_stepping_off_the_floor_seeds_the_pelvis_as_high_as_the_floor_leg_reache
     feet_z = np.mean([h.T_world_frame[2, 3] for h in stance.holds])
     assert planner._pelvis_target(straighten, stance.holds)[2] == pytest.approx(
         feet_z + straighten.primitive.pelvis_offset_m[2])
+
+
+def test_narrow_rails_mount_leaves_the_arms_a_lift_off_within_their_torque():
+    """Ship ladder (rails 0.79 m apart, 0.17 m outside the shoulders): the hands take the
+    rails clear of the shoulders, collision-free, and once the left foot is on rung 0 the
+    floor foot can lift with the compliant arms within their torque and the elbows off their
+    fold limit (with the hands beside the shoulders it was rarely found)."""
+    from planner.feasible import find_feasible
+
+    p = ClimbPlanner(load_ladder("ship"), seed=1)
+    q, stance = p.start_configuration()
+    steps = climb_sequence(0)
+    for step in steps[:2]:
+        _, q, stance = p.try_step(step, q, stance, 0.0, StepStats("x"))
+    support = tuple(h for h in stance.holds if h.limb != "right_foot")
+    pelvis = p._pelvis_target(steps[2], support)
+    target = p._target(steps[2], stance.holds, (), Stance(support),
+                       p._contacts(stance.holds), pelvis, q=q)
+    q_lift, verdict = find_feasible(p.kin, p.checker, q, target, np.random.default_rng(1),
+                                    attempts=3)
+    assert q_lift is not None and verdict.torque_ratio <= 1.0
+    fold_limit_rad = p.kin.model.lowerPositionLimit[p.kin.q_index["LEB"]]
+    for elbow in ("LEB", "REB"):
+        assert q_lift[p.kin.q_index[elbow]] > fold_limit_rad + 0.05

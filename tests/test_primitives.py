@@ -7,9 +7,10 @@ import pytest
 
 from ladders.geometry import LadderGeometry
 from ladders.loader import load_ladder
-from planner.holds import make_hold, palm_rotation
+from planner.holds import make_hold, palm_rotation, rail_point
 from primitives import RailSeed, RungSeed, climb_sequence
-from primitives.hold_seeds import FOOT_ALONG_M
+from primitives.hold_seeds import FOOT_ALONG_M, MOUNT_ALONG_RAIL_M
+from primitives.library import MOUNT_TORSO_ALONG_M
 from robot.params import DRC_HUBO
 
 
@@ -65,3 +66,24 @@ def test_grip_styles_keep_the_grip_axis_on_the_rail():
     assert R[:, 2] @ to_shoulder > 0  # the wrist points back towards the shoulder
     with pytest.raises(ValueError):
         palm_rotation(geom, "left", grip, shoulder, "sideways")
+
+
+@pytest.mark.parametrize("name", ["drc", "ship", "stair"])
+def test_mount_holds_leave_the_arms_room_from_the_shoulders_over_rung_0(name):
+    """Wide rails keep the low mount hold; close ones (ship) move it up the rail until it is
+    an upper arm's length, horizontally, from the shoulder of the torso over rung 0."""
+    geom = LadderGeometry(load_ladder(name))
+    seed = climb_sequence(0)[0].new_holds[0]
+    assert seed.limb == "left_hand" and seed.torso_along_m == MOUNT_TORSO_ALONG_M
+    p = make_hold(seed, geom, DRC_HUBO, shoulder_m=np.array([0.0, 0.23, 1.16]),
+                  grip_style="shoulder").T_world_frame[:3, 3]
+    shoulder = geom.rung_top_point(0, lateral_m=DRC_HUBO.half_shoulder_width_m,
+                                   along_m=MOUNT_TORSO_ALONG_M)
+    horizontal_m = np.linalg.norm(geom.to_ladder(p)[:2] - geom.to_ladder(shoulder)[:2])
+    low = rail_point(geom, "left", 0, MOUNT_ALONG_RAIL_M)
+    if name == "ship":
+        assert horizontal_m == pytest.approx(DRC_HUBO.upper_arm_m)
+        assert (p - low) @ geom.ladder_direction > 0.4
+    else:
+        np.testing.assert_allclose(p, low, atol=1e-12)
+        assert horizontal_m > DRC_HUBO.upper_arm_m
