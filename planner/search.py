@@ -46,6 +46,11 @@ POLISH_MAX_RAD = 0.1
 FOREARM_CLEARANCE_M = 0.05
 #: Weight of the seed pelvis position in IK (soft, against hard holds).
 PELVIS_WEIGHT = 1.0
+#: The planner keeps each wrist pitch this far short of the bend at which a closed hand's
+#: fingers touch its forearm [rad].
+WRIST_FOLD_MARGIN_RAD = 0.05
+#: Step of the scan for that bend [rad].
+WRIST_FOLD_SCAN_STEP_RAD = 0.01
 #: Start posture [rad], per side (roll signs mirrored): knees a little bent (a straight
 #: knee is an IK singularity), arms in a ready pose forward and out, elbows bent.
 START_POSTURE = {"HP": -0.2, "KN": 0.4, "AP": -0.2, "SP": -0.5, "SR": 0.3, "EB": -1.2}
@@ -120,6 +125,49 @@ def preferred_grip_style(geom: LadderGeometry, params) -> str:
     return "facing" if elbow_y >= torso_half_width + FOREARM_CLEARANCE_M else "shoulder"
 
 
+def closed_hand_wrist_pitch_range_rad(kin: HuboKinematics, collision: CollisionModel,
+                                      side: str) -> tuple[float, float]:
+    """The wrist pitch range [rad] over which the closed fingers of hand ``side`` (``L`` or
+    ``R``) clear its forearm at every wrist roll, within the joint's limits.
+
+    Closed fingers curl back towards the wrist; bent further, the forearm folds onto them.
+    Holding a rail, the hand's roll about it is free, and the IK, bounded by this range,
+    rolls it to keep the wrist clear instead of bending it onto the fingers.
+    """
+    pitch, roll = kin.q_index[f"{side}WP"], kin.q_index.get(f"{side}WR")
+    q = pin.neutral(kin.model)
+    for f in FINGER_JOINTS["left" if side == "L" else "right"]:
+        if f in kin.q_index:
+            q[kin.q_index[f]] = FINGER_CLOSED_RAD
+    rolls_rad = [0.0] if roll is None else np.linspace(
+        kin.model.lowerPositionLimit[roll], kin.model.upperPositionLimit[roll], 9)
+    geom, gdata, link_of = collision.geom, collision.gdata, collision.robot_link_of
+    pairs = [k for k, (a, b) in enumerate(collision.self_pairs)  # self pairs come first
+             if f"{side}_forearm" in (link_of[a], link_of[b])
+             and f"{side}_finger" in link_of[a] + link_of[b]]
+
+    def folded(q_pitch_rad: float) -> bool:
+        q[pitch] = q_pitch_rad
+        for q_roll_rad in rolls_rad:
+            if roll is not None:
+                q[roll] = q_roll_rad
+            pin.updateGeometryPlacements(kin.model, kin.data, geom, gdata, q)
+            if any(pin.computeCollision(geom, gdata, k) for k in pairs):
+                return True
+        return False
+
+    out = []
+    for limit_rad in (kin.model.lowerPositionLimit[pitch], kin.model.upperPositionLimit[pitch]):
+        step_rad = np.copysign(WRIST_FOLD_SCAN_STEP_RAD, limit_rad)
+        bound_rad = limit_rad
+        for angle_rad in np.arange(step_rad, limit_rad, step_rad):
+            if folded(angle_rad):
+                bound_rad = angle_rad - np.copysign(WRIST_FOLD_MARGIN_RAD, limit_rad)
+                break
+        out.append(float(bound_rad))
+    return out[0], out[1]
+
+
 def _limb_side(limb: str) -> str:
     return "left" if limb.startswith("left") else "right"
 
@@ -135,6 +183,9 @@ class ClimbPlanner:
         self.geom = LadderGeometry(spec)
         self.kin = HuboKinematics.load(robot)
         self.collision = CollisionModel(self.kin, ladder_collision_objects(spec))
+        for side in "LR":  # the IK and the checker both keep the wrists inside this range
+            self.kin.wrapper.set_joint_limits(
+                f"{side}WP", *closed_hand_wrist_pitch_range_rad(self.kin, self.collision, side))
         self.checker = FeasibilityChecker(self.kin, self.collision, config.min_margin_m,
                                           config.arm_strategy, config.max_torque_ratio)
         self.config = config

@@ -44,6 +44,11 @@ STRAIGHTEN = Primitive("straighten", (), {**_ARMS, **_STAND}, pelvis_offset_m=(-
 #: must leave the arms room from there.
 MOUNT_TORSO_ALONG_M = FOOT_ALONG_M + PLACE_R_FOOT.pelvis_offset_m[0]
 
+#: Where the torso stands over rung k+1 once the left foot carries it there (moveRFoot's
+#: pelvis seed over that foot), up-ladder of the tread centre [m]: the hands' holds above
+#: rung k+1 must leave the arms room from there, as the mount holds do from rung 0.
+CLIMB_TORSO_ALONG_M = FOOT_ALONG_M + MOVE_R_FOOT.pelvis_offset_m[0]
+
 PRIMITIVES = {p.name: p for p in (PLACE_HANDS, PLACE_L_FOOT, PLACE_R_FOOT, MOVE_L_HAND,
                                   MOVE_R_HAND, MOVE_L_FOOT, MOVE_R_FOOT, STRAIGHTEN)}
 
@@ -61,8 +66,8 @@ def climb_sequence(top_rung: int) -> list[Step]:
     ]
     for k in range(top_rung):
         steps += [
-            Step(MOVE_L_HAND, (hand_on_rail("left_hand", k + 1),), k),
-            Step(MOVE_R_HAND, (hand_on_rail("right_hand", k + 1),), k),
+            Step(MOVE_L_HAND, (hand_on_rail("left_hand", k + 1, 0.0, CLIMB_TORSO_ALONG_M),), k),
+            Step(MOVE_R_HAND, (hand_on_rail("right_hand", k + 1, 0.0, CLIMB_TORSO_ALONG_M),), k),
             Step(MOVE_L_FOOT, (foot_on_rung("left_foot", k + 1),), k + 1),
             Step(MOVE_R_FOOT, (foot_on_rung("right_foot", k + 1),), k + 1),
             Step(STRAIGHTEN, (), k + 1),

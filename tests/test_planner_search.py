@@ -200,3 +200,45 @@ def test_narrow_rails_mount_leaves_the_arms_a_lift_off_within_their_torque():
     fold_limit_rad = p.kin.model.lowerPositionLimit[p.kin.q_index["LEB"]]
     for elbow in ("LEB", "REB"):
         assert q_lift[p.kin.q_index[elbow]] > fold_limit_rad + 0.05
+
+
+@pytest.mark.parametrize("robot", ["drc-hubo", "hubo2plus"])
+def test_wrist_pitch_stops_short_of_the_closed_fingers(robot):
+    """Bent far enough, the forearm folds onto a closed hand's fingers (on the ship ladder
+    the IK rolled the hands about the rails into that bend until no foot could lift): the
+    planner bounds each wrist pitch where they still clear it at every wrist roll."""
+    import pinocchio as pin
+
+    from planner.kinematics import HuboKinematics
+    from planner.search import WRIST_FOLD_MARGIN_RAD, WRIST_FOLD_SCAN_STEP_RAD
+    from robot.joints import FINGER_JOINTS
+    from robot.kinematic_tree import FINGER_CLOSED_RAD
+
+    p = ClimbPlanner(load_ladder("ship"), robot=robot)
+    kin = p.kin
+    q = pin.neutral(kin.model)
+    for name in FINGER_JOINTS["left"]:
+        q[kin.q_index[name]] = FINGER_CLOSED_RAD
+    i, roll = kin.q_index["LWP"], kin.q_index.get("LWR")
+    lo, hi = kin.model.lowerPositionLimit[i], kin.model.upperPositionLimit[i]
+    assert p.checker._lower[i - 7] == lo and p.checker._upper[i - 7] == hi
+    rolls = [0.0] if roll is None else np.linspace(kin.model.lowerPositionLimit[roll],
+                                                   kin.model.upperPositionLimit[roll], 9)
+
+    def folded(pitch_rad):
+        for r in rolls:
+            q[i] = pitch_rad
+            if roll is not None:
+                q[roll] = r
+            if any("L_forearm" in a and "L_finger" in b
+                   for a, b in p.collision.colliding_pairs(q)):
+                return True
+        return False
+
+    joint = HuboKinematics.load(robot).model
+    beyond = WRIST_FOLD_MARGIN_RAD + WRIST_FOLD_SCAN_STEP_RAD
+    for bound, joint_limit in ((lo, joint.lowerPositionLimit[i]),
+                               (hi, joint.upperPositionLimit[i])):
+        assert not folded(bound)
+        assert bound == joint_limit or folded(bound + np.copysign(beyond, bound))
+    assert (lo, hi) != (joint.lowerPositionLimit[i], joint.upperPositionLimit[i])

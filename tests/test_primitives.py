@@ -10,7 +10,7 @@ from ladders.loader import load_ladder
 from planner.holds import make_hold, palm_rotation, rail_point
 from primitives import RailSeed, RungSeed, climb_sequence
 from primitives.hold_seeds import FOOT_ALONG_M, MOUNT_ALONG_RAIL_M
-from primitives.library import MOUNT_TORSO_ALONG_M
+from primitives.library import CLIMB_TORSO_ALONG_M, MOUNT_TORSO_ALONG_M
 from robot.params import DRC_HUBO
 
 
@@ -87,3 +87,24 @@ def test_mount_holds_leave_the_arms_room_from_the_shoulders_over_rung_0(name):
     else:
         np.testing.assert_allclose(p, low, atol=1e-12)
         assert horizontal_m > DRC_HUBO.upper_arm_m
+
+
+@pytest.mark.parametrize("name", ["drc", "ship", "stair"])
+def test_climb_holds_leave_the_arms_room_from_the_torso_over_their_rung(name):
+    """The holds above rung k+1 carry the body once it stands over rung k+1: like the mount
+    holds, close rails (ship) move them up the rail, away from that torso's shoulders."""
+    geom = LadderGeometry(load_ladder(name))
+    step = climb_sequence(2)[4]
+    seed = step.new_holds[0]
+    assert step.primitive.name == "moveLHand" and seed.rung == 1
+    assert seed.torso_along_m == CLIMB_TORSO_ALONG_M
+    p = make_hold(seed, geom, DRC_HUBO).T_world_frame[:3, 3]
+    shoulder = geom.rung_top_point(1, lateral_m=DRC_HUBO.half_shoulder_width_m,
+                                   along_m=CLIMB_TORSO_ALONG_M)
+    horizontal_m = np.linalg.norm(geom.to_ladder(p)[:2] - geom.to_ladder(shoulder)[:2])
+    above = rail_point(geom, "left", 1)
+    if name == "ship":
+        assert horizontal_m == pytest.approx(DRC_HUBO.upper_arm_m)
+        assert (p - above) @ geom.ladder_direction > 0.1
+    else:
+        np.testing.assert_allclose(p, above, atol=1e-12)
