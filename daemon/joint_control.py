@@ -59,8 +59,8 @@ from daemon.control_modes import (
 from daemon.pwm import PwmGains, pwm_duty
 from robot.errors import InputError
 from robot.joints import ARM_JOINTS, FINGER_JOINTS, JOINT_INDEX, JOINT_NAMES, NUM_JOINTS
-from robot.pwm_gains import PWM_COMMAND_LIMIT_PCT
 from robot.limits import JointLimits, joint_limits
+from robot.pwm_gains import PWM_COMMAND_LIMIT_PCT
 
 __all__ = [
     "ComplianceState",

@@ -115,9 +115,8 @@ def _load(args):
                          no_filter=args.no_filter, start_line=args.line)
     if not (np.isfinite(args.line_tolerance) and args.line_tolerance > 0):
         raise InputError(f"--line-tolerance {args.line_tolerance}: must be > 0 [rad]")
-    player = TrajectoryPlayer(
-        traj, opts, schedule, sidecar.arm_feedforward if auto else None,
-        {arm: sidecar.hand_holding(arm) for arm in ("left", "right")} if auto else None)
+    player = TrajectoryPlayer(traj, opts, schedule, sidecar.arm_feedforward if auto else None,
+                              sidecar.hands_holding() if auto else None)
     return traj, player, auto
 
 
@@ -188,7 +187,6 @@ class _Keys:
 def _play(args, traj, player, auto) -> int:
     from daemon.channels import open_channel
     from daemon.loop import sleep_until_ns
-    from daemon.pwm import feedforward_duty_pct
     from daemon.structs import REF_DTYPE, new_sample
     from robot.motors import DEFAULT_BATTERY_V, motor_table
 
@@ -232,7 +230,10 @@ def _play(args, traj, player, auto) -> int:
                 flags["toggles"] += keys.presses()
             if flags["stop"]:
                 break
-            latest = state.read_latest()
+            # The state only matters for go-to-init's start pose and the feed-forward's
+            # battery voltage.
+            latest = state.read_latest() if not player.started or player.has_feedforward \
+                else None
             pos = np.asarray(latest["pos"]) if not player.started else None
             if player.started:
                 while flags["toggles"]:
@@ -244,9 +245,8 @@ def _play(args, traj, player, auto) -> int:
             sample["comply"] = tick.comply
             if player.has_feedforward:
                 volts = float(latest["power"]["V"])
-                sample["pwm_command"] = feedforward_duty_pct(
-                    tick.feedforward_nm, volts if volts > 0 else DEFAULT_BATTERY_V,
-                    tick.velocity_rad_s, motors)
+                sample["pwm_command"] = player.feedforward_duty(
+                    tick, volts if volts > 0 else DEFAULT_BATTERY_V, motors)
             if tick.finished:
                 sample["playing"] = 0
             ref.write(sample)

@@ -32,7 +32,8 @@ the torque LP's share of the load for a hand on a rail, the arm's own weight for
 in the air); each tick carries them, interpolated between the sampled lines, for the
 joints in PWM mode (0 elsewhere, and during go-to-init), with the velocity the daemon's
 reference filter will give the reference (the motor's back-EMF costs duty while it
-moves). The caller turns them into hubo-ach's feed-forward duty (``pwm_command``).
+moves). `TrajectoryPlayer.feedforward_duty` turns them into hubo-ach's feed-forward duty
+(``pwm_command``) at the battery voltage the caller knows.
 
 Force control of a holding arm. With feed-forward, on lines where the sidecar says a
 hand holds its rail (``holding``) and its arm is in PWM mode, the arm's compliant joints
@@ -53,8 +54,10 @@ from types import MappingProxyType
 import numpy as np
 
 from daemon.control_modes import TICK_S, RefMode, default_filter_config, filter_reference
+from daemon.pwm import feedforward_duty_pct
 from robot.errors import HuboLadderError, InputError
 from robot.joints import ARM_JOINTS, NUM_JOINTS, joint_indices
+from robot.motors import MotorTable
 from robot.plan_sidecar import ArmFeedforward
 
 __all__ = [
@@ -275,7 +278,8 @@ class PlayerTick:
         comply: joints asked to be compliant (PWM), shape (40,) bool.
         feedforward_nm: feed-forward torque of the compliant joints [N·m], shape (40,).
         velocity_rad_s: velocity of the reference as the daemon's filter sends it
-            [rad/s], shape (40,); 0 during go-to-init and pauses.
+            [rad/s], shape (40,); 0 during go-to-init and pauses, and without
+            feed-forward (only the feed-forward uses it).
         line_index: 0-based trajectory row being played (the start row during go-to-init).
         arm_modes: arm → ``"position"`` or ``"pwm"``.
         going_to_init: the go-to-init move is in progress.
@@ -331,7 +335,7 @@ class TrajectoryPlayer:
             mapping); both arms in position mode when None.
         feedforward: the sidecar's arm torques; no feed-forward when None.
         holding: arm → bool (N,), lines on which its hand holds a rail
-            (`robot.plan_sidecar.PlanSidecar.hand_holding`); with ``feedforward``, those
+            (`robot.plan_sidecar.PlanSidecar.hands_holding`); with ``feedforward``, those
             lines are force-controlled (module docstring). None: no line.
 
     Raises:
@@ -405,6 +409,7 @@ class TrajectoryPlayer:
             self._holding[arm] = lines
         self._force_cols = {arm: joint_indices(ARM_JOINTS[arm]) for arm in ARMS}
         self._filtered_rad: np.ndarray | None = None
+        self._filter_length = default_filter_config().filter_length
         self._start_row = self.options.start_line - 1
         self._init_s = self.options.go_to_init_s if self.options.go_to_init else 0.0
         self._t0_s: float | None = None
@@ -523,18 +528,8 @@ class TrajectoryPlayer:
         left = bool(self._pwm_by_line["left"][row])
         right = bool(self._pwm_by_line["right"][row])
         comply = self._comply[(left, right)]
-        velocity = self._filter_velocity(ref, going_to_init)
-        feedforward = np.zeros(NUM_JOINTS)
-        mode = self._mode
-        if self._feedforward is not None and not going_to_init:
-            feedforward[self._ff_cols] = self._feedforward_at(row)
-            feedforward[~comply] = 0.0
-            held = [arm for arm, pwm in (("left", left), ("right", right))
-                    if pwm and self._holding[arm][row]]
-            if held:
-                mode = self._mode.copy()
-                for arm in held:
-                    mode[self._force_cols[arm]] = RefMode.COMPLIANT
+        feedforward, velocity, mode = self._feedforward_tick(ref, row, comply, (left, right),
+                                                             going_to_init)
         return PlayerTick(
             ref_rad=ref,
             mode=mode,
@@ -548,7 +543,35 @@ class TrajectoryPlayer:
             finished=finished,
         )
 
+    def feedforward_duty(self, tick: PlayerTick, battery_v: float,
+                         motors: MotorTable | None = None) -> np.ndarray | None:
+        """The tick's feed-forward as duty [%] (`daemon.pwm.feedforward_duty_pct`, with
+        the reference's velocity), or None when the player has no feed-forward."""
+        if self._feedforward is None:
+            return None
+        return feedforward_duty_pct(tick.feedforward_nm, battery_v, tick.velocity_rad_s,
+                                    motors)
+
     # ----------------------------------------------------------------- internals
+    def _feedforward_tick(self, ref: np.ndarray, row: int, comply: np.ndarray,
+                          pwm: tuple[bool, bool], going_to_init: bool):
+        """(feed-forward [N·m], reference velocity [rad/s], modes) of a tick: zeros and
+        the plain modes without feed-forward (module docstring)."""
+        feedforward = np.zeros(NUM_JOINTS)
+        if self._feedforward is None:
+            return feedforward, np.zeros(NUM_JOINTS), self._mode
+        velocity = self._filter_velocity(ref, going_to_init)
+        if going_to_init:
+            return feedforward, velocity, self._mode
+        feedforward[self._ff_cols] = self._feedforward_at(row)
+        feedforward[~comply] = 0.0
+        mode = self._mode
+        for arm, arm_pwm in zip(ARMS, pwm, strict=True):
+            if arm_pwm and self._holding[arm][row]:
+                mode = mode.copy() if mode is self._mode else mode
+                mode[self._force_cols[arm]] = RefMode.COMPLIANT
+        return feedforward, velocity, mode
+
     def _filter_velocity(self, ref: np.ndarray, going_to_init: bool) -> np.ndarray:
         """Velocity of ``ref`` through the daemon's reference filter [rad/s] (0 while
         paused or going to the start line, where the filter is reset onto ``ref``)."""
@@ -558,8 +581,7 @@ class TrajectoryPlayer:
             return np.zeros(NUM_JOINTS)
         if self.paused:
             return np.zeros(NUM_JOINTS)
-        self._filtered_rad = filter_reference(self._mode, ref, prev, prev,
-                                              default_filter_config().filter_length)
+        self._filtered_rad = filter_reference(self._mode, ref, prev, prev, self._filter_length)
         return (self._filtered_rad - prev) / TICK_S
 
     def _feedforward_at(self, row: int) -> np.ndarray:

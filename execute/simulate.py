@@ -35,7 +35,7 @@ from daemon.board_model import TICK_S, BoardModel, BoardModelConfig, PlacementEr
 from daemon.board_trip import TripEvent
 from daemon.grasp_latch import GraspEvent
 from daemon.joint_control import JointController
-from daemon.pwm import PwmGains, default_drc_gains, feedforward_duty_pct
+from daemon.pwm import PwmGains, default_drc_gains
 from execute.player import ArmModeSchedule, PlayerOptions, TrajectoryPlayer
 from execute.verdict import Verdict, VerdictConfig, VerdictMonitor
 from ladders.geometry import LadderGeometry
@@ -152,8 +152,7 @@ def simulate(trajectory_rad: np.ndarray, sidecar: PlanSidecar, ladder: LadderSpe
     rate = int(round(sidecar.rate_hz))
     player = TrajectoryPlayer(trajectory_rad, PlayerOptions(rate_hz=rate,
                                                             compliant_arms=compliant),
-                              schedule, sidecar.arm_feedforward,
-                              {arm: sidecar.hand_holding(arm) for arm in ("left", "right")})
+                              schedule, sidecar.arm_feedforward, sidecar.hands_holding())
     controller = JointController(robot=robot)
     gains = opt.gains or default_drc_gains()
     monitor = VerdictMonitor(board, sidecar, T_err, player.time_of_line, opt.verdict)
@@ -185,10 +184,8 @@ def simulate(trajectory_rad: np.ndarray, sidecar: PlanSidecar, ladder: LadderSpe
         vel_now = board.joint_vel()
         tick = player.step(now, pos_now)
         line_index = tick.line_index
-        feedforward = None if not player.has_feedforward else feedforward_duty_pct(
-            tick.feedforward_nm, opt.board.battery_v, tick.velocity_rad_s, board.motors)
         out = controller.tick(tick.ref_rad, tick.mode, tick.comply, pos_now, vel_now, gains,
-                              feedforward)
+                              player.feedforward_duty(tick, opt.board.battery_v, board.motors))
         board.apply(out)
         trips, grasps = board.step()
         trips_all += trips

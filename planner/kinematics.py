@@ -14,7 +14,6 @@ from robot.joints import ARM_JOINTS, JOINT_NAMES
 from robot.params import RobotParams, robot_params
 from robot.urdf import robot_urdf
 
-
 #: The planner keeps the arm joints this far inside their limits [rad]: a compliant arm
 #: pressed on its mechanical stop is rigid in that direction, and the stop, not the
 #: planned torques, then decides what its hand carries.

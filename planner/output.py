@@ -31,6 +31,7 @@ from robot.plan_sidecar import (
     HoldRecord,
     PlanSidecar,
     Segment,
+    feedforward_rows,
     hand_holding_lines,
     sidecar_path,
     write_sidecar,
@@ -259,8 +260,7 @@ def arm_feedforward(result: SearchResult, timed: TimedPlan, after: list[dict[str
 
     step_of_segment = {i: g for g, idx in enumerate(step_groups(result.segments)) for i in idx}
     joints = tuple(n for side in ARMS for n in ARM_JOINTS[side])
-    ff = ArmFeedforward(every_lines, joints, np.zeros((0, len(joints))))
-    rows = ff.rows_for(timed.line_count)
+    rows = feedforward_rows(timed.line_count, every_lines)
     torque = np.zeros((rows, len(joints)))
     stances: dict[tuple[int, bool], Stance] = {}
     for k in range(rows):

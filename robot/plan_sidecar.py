@@ -59,6 +59,12 @@ class Segment:
     moving_limbs: tuple[str, ...] = ()
 
 
+def feedforward_rows(line_count: int, every_lines: int) -> int:
+    """Rows of an `ArmFeedforward` sampled every ``every_lines`` that cover lines
+    1..line_count: the last row is at or past the last line."""
+    return (line_count - 2) // every_lines + 2 if line_count > 1 else 1
+
+
 def hand_holding_lines(segments: Sequence[Segment], line_count: int, arm: str) -> np.ndarray:
     """Lines on which the ``arm`` ("left"/"right") hand holds a rail, bool (line_count,)."""
     held = np.zeros(line_count, dtype=bool)
@@ -82,7 +88,8 @@ class ArmFeedforward:
         every_lines: sample spacing [lines]; row k belongs to line ``1 + k·every_lines``
             and the player interpolates linearly between rows.
         joints: the arm joints of the columns (names of `robot.joints.ARM_JOINTS`).
-        torque_nm: (rows, len(joints)) joint torques [N·m]; 0 where the hand holds nothing.
+        torque_nm: (rows, len(joints)) joint torques [N·m]; an arm whose hand holds
+            nothing has its own gravity torques.
     """
 
     every_lines: int
@@ -90,8 +97,8 @@ class ArmFeedforward:
     torque_nm: np.ndarray
 
     def rows_for(self, line_count: int) -> int:
-        """Rows that sample lines 1..line_count: the last row is at or past the last line."""
-        return (line_count - 2) // self.every_lines + 2 if line_count > 1 else 1
+        """Rows that cover lines 1..line_count (`feedforward_rows`)."""
+        return feedforward_rows(line_count, self.every_lines)
 
     def to_json(self) -> dict[str, Any]:
         return {"every_lines": self.every_lines, "joints": list(self.joints),
@@ -114,9 +121,10 @@ class PlanSidecar:
     joint_order: tuple[str, ...] = JOINT_NAMES
     arm_feedforward: ArmFeedforward | None = None
 
-    def hand_holding(self, arm: str) -> np.ndarray:
-        """Lines on which the ``arm`` ("left"/"right") hand holds a rail, bool (line_count,)."""
-        return hand_holding_lines(self.segments, self.line_count, arm)
+    def hands_holding(self) -> dict[str, np.ndarray]:
+        """Arm ("left"/"right") → lines on which its hand holds a rail, bool (line_count,)."""
+        return {arm: hand_holding_lines(self.segments, self.line_count, arm)
+                for arm in ("left", "right")}
 
     def segment_at(self, line: int) -> Segment:
         for seg in self.segments:
@@ -201,8 +209,7 @@ def _feedforward(d: Any, where: str, line_count: int) -> ArmFeedforward | None:
             or len(set(joints)) != len(joints):
         raise SidecarError(f"{where}.joints: expected distinct arm joint names "
                            f"({' '.join(sorted(arm))}), got {joints!r}")
-    ff = ArmFeedforward(every, tuple(joints), np.zeros((0, len(joints))))
-    rows = ff.rows_for(line_count)
+    rows = feedforward_rows(line_count, every)
     try:
         torque = np.array(d["torque_nm"], dtype=float)
     except (TypeError, ValueError):

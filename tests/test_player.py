@@ -362,5 +362,6 @@ def test_a_holding_pwm_arm_is_force_controlled_with_feedforward_only():
 
 
 def test_feedforward_must_cover_the_file():
-    with pytest.raises(ModeScheduleError, match="feed-forward has 6 rows; 40 lines every 4 need 11"):
+    with pytest.raises(ModeScheduleError,
+                       match="feed-forward has 6 rows; 40 lines every 4 need 11"):
         TrajectoryPlayer(_ramp(40), feedforward=_feedforward(20, 4))
