@@ -30,12 +30,13 @@ from planner.interpolation import (
 )
 from planner.kinematics import HuboKinematics
 from planner.limb_path import foot_waypoints, hand_waypoints
+from planner.limb_rrt import plan_limb_path
 from planner.validity import FeasibilityChecker
 from primitives.hold_seeds import FloorSeed, RailSeed
 from primitives.library import climb_sequence
 from primitives.primitive import Step
 from robot.errors import HuboLadderError
-from robot.joints import ARM_JOINTS, FINGER_JOINTS
+from robot.joints import ARM_JOINTS, FINGER_JOINTS, LEG_JOINTS
 from robot.kinematic_tree import FINGER_CLOSED_RAD
 
 log = logging.getLogger(__name__)
@@ -73,6 +74,11 @@ class PlannerConfig:
     # a position-controlled leg and a compliant arm really share differing from the LP's
     # optimum; at 0.85 the DRC mount has no solution, so the default is the limit itself.
     max_torque_ratio: float = 1.0
+    # The OMPL fallback (planner.limb_rrt): RRTConnect's budget in validity checks (the
+    # arms through a steep ladder's rungs took 14,000–26,000, ≈ 1 ms each), tried on at
+    # most this many samples of a step, as a failed search costs the whole budget.
+    limb_rrt_max_checks: int = 30000
+    limb_rrt_tries_per_step: int = 2
 
 
 class PlanningFailed(HuboLadderError):
@@ -104,6 +110,8 @@ class StepStats:
     min_margin_m: float = np.inf
     max_torque_ratio: float = 0.0
     failures: dict[str, int] = field(default_factory=dict)
+    limb_detours: int = 0  # limb paths found by RRTConnect where the arc collided
+    limb_detour_tries: int = 0
 
 
 @dataclass
@@ -331,6 +339,46 @@ class ClimbPlanner:
         stats.max_torque_ratio = max(stats.max_torque_ratio, istats.max_torque_ratio)
         return path
 
+    def _limb_detour(self, qa, qb, limbs, support, stability, contacts, stats: StepStats,
+                     exc: InterpolationError) -> list[np.ndarray]:
+        """The OMPL fallback (`planner.limb_rrt`) where the arc between two way-point
+        configurations collides: the body moves to ``qb``'s with the moving limbs' joints
+        held (contact-space interpolation), then RRTConnect moves one limb at a time with
+        everything else held (a 7- or 6-joint space each, not all moving limbs at once).
+        Re-raises ``exc`` when that finds nothing or the arc failed otherwise."""
+        if (not exc.reason.startswith("midpoint infeasible: collision")
+                or stats.limb_detour_tries >= self.config.limb_rrt_tries_per_step):
+            raise exc
+        stats.limb_detour_tries += 1
+        limb_idx = {limb: [self.kin.q_index[n] for n in self._limb_joints(limb)]
+                    for limb in limbs}
+        q_cur = qb.copy()
+        for idx in limb_idx.values():
+            q_cur[idx] = qa[idx]
+        if not self.checker.check(q_cur, stability, contacts).ok:
+            raise exc
+        path = (self._interp(qa, q_cur, support, stability, contacts, stats)
+                if self.kin.joint_distance(qa, q_cur) > 0 else [])
+        for limb, idx in limb_idx.items():
+            q_next = q_cur.copy()
+            q_next[idx] = qb[idx]
+            if self.kin.joint_distance(q_cur, q_next) == 0:
+                continue
+            part = plan_limb_path(self.kin, self.checker, q_cur, q_next,
+                                  self._limb_joints(limb), stability, contacts,
+                                  resolution_rad=self.config.resolution_rad,
+                                  max_checks=self.config.limb_rrt_max_checks)
+            if part is None:
+                raise exc
+            path += part
+            q_cur = q_next
+        stats.limb_detours += 1
+        return path
+
+    def _limb_joints(self, limb: str) -> list[str]:
+        table = ARM_JOINTS if limb.endswith("hand") else LEG_JOINTS
+        return [n for n in table[_limb_side(limb)] if n in self.kin.q_index]
+
     # ----------------------------------------------------------------------------------
     def try_step(self, step: Step, q: np.ndarray, stance: Stance, radius_m: float,
                  stats: StepStats, attempt: int = 0
@@ -422,8 +470,12 @@ class ClimbPlanner:
             if q_next is None:
                 raise _StepRejected(f"way-point {i}/{n_way - 1}: {_why(verdict)}")
             self._remember(step, i, q_next)
-            limb_path += self._interp(q_cur, q_next, support, support_stance, contacts,
-                                      stats, moving=targets)
+            try:
+                limb_path += self._interp(q_cur, q_next, support, support_stance, contacts,
+                                          stats, moving=targets)
+            except InterpolationError as exc:
+                limb_path += self._limb_detour(q_cur, q_next, moving_limbs, support,
+                                               support_stance, contacts, stats, exc)
             q_cur = q_next
         segments.append(PathSegment(step, "limb", support, moving_limbs, limb_path))
 

@@ -242,3 +242,84 @@ def test_wrist_pitch_stops_short_of_the_closed_fingers(robot):
         assert not folded(bound)
         assert bound == joint_limit or folded(bound + np.copysign(beyond, bound))
     assert (lo, hi) != (joint.lowerPositionLimit[i], joint.upperPositionLimit[i])
+
+
+def _left_arm_pair(planner, q):
+    """Two left-arm poses of the standing robot whose straight joint-space line passes the
+    forearm through the left rail (found by a seeded search, values rounded)."""
+    from robot.joints import LEFT_ARM
+
+    a, b = q.copy(), q.copy()
+    idx = [planner.kin.q_index[n] for n in LEFT_ARM]
+    a[idx] = [0.85, 0.22, 1.44, -0.73, -0.74, -0.29, -1.08]
+    b[idx] = [-1.39, 1.2, 0.79, -0.62, -0.43, 1.84, 1.1]
+    return a, b
+
+
+def test_rrt_fallback_goes_around_what_the_straight_line_hits(planner, standing):
+    from planner.limb_rrt import plan_limb_path
+    from robot.joints import LEFT_ARM
+
+    q, stance = standing
+    contacts = {h.limb: h.target for h in stance.holds}
+    a, b = _left_arm_pair(planner, q)
+    check = planner.checker.check
+    assert check(a, stance, contacts).ok and check(b, stance, contacts).ok
+    line = [planner.kin.interpolate(a, b, s) for s in np.linspace(0, 1, 60)]
+    assert any(not check(x, stance, contacts).ok for x in line)  # the arc would fail
+
+    path = plan_limb_path(planner.kin, planner.checker, a, b, LEFT_ARM, stance, contacts,
+                          resolution_rad=0.01)
+    assert path is not None
+    np.testing.assert_array_equal(path[-1], b)
+    steps = [planner.kin.joint_distance(x, y) for x, y in zip([a] + path[:-1], path, strict=True)]
+    assert max(steps) <= 0.01 + 1e-9
+    idx = [planner.kin.q_index[n] for n in LEFT_ARM]
+    rest = np.setdiff1d(np.arange(len(q)), idx)
+    for x in path:
+        np.testing.assert_array_equal(x[rest], a[rest])  # the body is held
+        assert check(x, stance, contacts).ok
+
+
+_RRT_IN_A_FRESH_PROCESS = '''
+import hashlib, sys
+import numpy as np
+sys.path.insert(0, {tests!r})
+from test_planner_search import _left_arm_pair
+from ladders.loader import load_ladder
+from planner.limb_rrt import plan_limb_path
+from planner.search import ClimbPlanner
+from robot.joints import LEFT_ARM
+p = ClimbPlanner(load_ladder("drc"), seed=1)
+q, stance = p.start_configuration()
+a, b = _left_arm_pair(p, q)
+path = plan_limb_path(p.kin, p.checker, a, b, LEFT_ARM, stance,
+                      {{h.limb: h.target for h in stance.holds}})
+print(hashlib.sha256(np.array(path).tobytes()).hexdigest())
+'''
+
+
+def test_rrt_fallback_is_deterministic_per_process():
+    # OMPL draws from one process-wide generator seeded once with a fixed seed, and the
+    # search budget counts validity checks, not seconds: a fresh process (plan-ladder)
+    # gives the same path every time.
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    code = _RRT_IN_A_FRESH_PROCESS.format(tests=str(Path(__file__).parent))
+    runs = [subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                           check=True).stdout.split()[0] for _ in range(2)]
+    assert runs[0] == runs[1]
+
+
+def test_rrt_fallback_holds_the_body(planner, standing):
+    from planner.limb_rrt import plan_limb_path
+    from robot.joints import LEFT_ARM
+
+    q, stance = standing
+    a, b = _left_arm_pair(planner, q)
+    b[planner.kin.q_index["RSP"]] += 0.1  # another limb moves too: not this planner's job
+    with pytest.raises(ValueError, match="differ only in the moving joints"):
+        plan_limb_path(planner.kin, planner.checker, a, b, LEFT_ARM, stance,
+                       {h.limb: h.target for h in stance.holds})
