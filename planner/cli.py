@@ -54,7 +54,8 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--dwell", type=float, default=0.5, metavar="S",
                    help="quasi-static hold after each step [s] (default 0.5)")
     p.add_argument("--plots", metavar="DIR", help="write the CoM/support-region plot of "
-                                                  "each stance into DIR")
+                                                  "each stance and a snapshot strip of the "
+                                                  "plan (snapshots.png) into DIR")
     p.add_argument("-v", "--verbose", action="count", default=0,
                    help="log planner progress (-vv: every rejected sample)")
     return p
@@ -157,6 +158,15 @@ def _plan(args: argparse.Namespace, err) -> int:
 
         files = write_stance_plots(result, planner, args.plots)
         log.info("wrote %d stance plots into %s", len(files), args.plots)
+        from ladders.render import RenderingUnavailable
+        from planner.plots import write_plan_strip
+
+        try:
+            strip = write_plan_strip(out.timed.configs, planner.kin, spec,
+                                     Path(args.plots) / "snapshots.png")
+            log.info("wrote %s", strip)
+        except RenderingUnavailable as exc:
+            err.print(f"plan-ladder: no snapshot strip: {exc}", markup=False)
     console = Console()
     if not console.is_terminal:  # a log file or a pipe: keep each row on one line
         console = Console(width=200)
@@ -174,6 +184,10 @@ def main(argv: list[str] | None = None) -> int:
         args = _parser().parse_args(argv)
     except SystemExit as exc:  # argparse: --help (0) or a bad option (2)
         return int(exc.code or 0)
+    if args.plots:
+        import os
+
+        os.environ.setdefault("MUJOCO_GL", "egl")  # headless, before mujoco is imported
     err = Console(stderr=True)
     level = (logging.WARNING, logging.INFO, logging.DEBUG)[min(args.verbose, 2)]
     logging.basicConfig(level=level, format="%(name)s: %(message)s",

@@ -1,10 +1,14 @@
-"""Per-stance plots of a plan: the CoM trace against the stance's support region.
+"""Pictures of a plan: per-stance CoM plots and a snapshot strip.
 
-One PNG per stance (a set of holds in contact), in the order the plan first uses it:
+Stance plots: one PNG per stance (a set of holds in contact), in the order the plan first uses it:
 the support region polygon (the CoM positions where gravity can be balanced within the
 friction cones), the ground projection of the holds, and the CoM of every configuration
 the plan passes through in that stance. Rendered with matplotlib's Agg backend (no
 display needed).
+
+Snapshot strip: ``snapshots.png``, planned configurations at evenly spaced lines drawn in
+the MuJoCo scene of the ladder (`ladders.render`, headless with ``MUJOCO_GL=egl``), the
+same view ``validate-plan`` gives of the simulated climb.
 """
 
 from __future__ import annotations
@@ -19,7 +23,7 @@ import numpy as np
 if TYPE_CHECKING:
     from planner.search import ClimbPlanner, SearchResult
 
-__all__ = ["stance_groups", "write_stance_plots"]
+__all__ = ["plan_qpos", "stance_groups", "write_plan_strip", "write_stance_plots"]
 
 
 def _stance_key(holds) -> tuple:
@@ -111,3 +115,37 @@ def write_stance_plots(result: SearchResult, planner: ClimbPlanner,
         plt.close(fig)
         written.append(path)
     return written
+
+
+def plan_qpos(model, kin, configs: np.ndarray) -> np.ndarray:
+    """MuJoCo ``qpos`` rows of the scene ``model`` for planner configurations (pinocchio
+    layout: base position, quaternion x y z w, then the joints)."""
+    import mujoco
+
+    from robot.mjcf import joint_qpos_addresses
+
+    root = next(j for j in range(model.njnt)
+                if model.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE)
+    base = int(model.jnt_qposadr[root])
+    joints = [(adr, kin.q_index[name]) for name, adr in joint_qpos_addresses(model).items()
+              if name in kin.q_index]
+    out = np.tile(model.qpos0, (len(configs), 1))
+    for row, q in zip(out, np.atleast_2d(configs), strict=True):
+        row[base:base + 3] = q[:3]
+        row[base + 3:base + 7] = (q[6], q[3], q[4], q[5])  # MuJoCo: w x y z
+        for adr, i in joints:
+            row[adr] = q[i]
+    return out
+
+
+def write_plan_strip(configs: np.ndarray, kin, ladder, path: str | os.PathLike,
+                     count: int = 6) -> Path:
+    """``count`` planned configurations, evenly spaced over the plan's lines, side by
+    side in one PNG (raises `ladders.render.RenderingUnavailable` without EGL)."""
+    from ladders.render import SNAPSHOT_SIZE, render_states, write_strip
+    from ladders.scene import build_scene
+
+    model = build_scene(ladder, kin.params).compile()
+    lines = np.linspace(0, len(configs) - 1, count).round().astype(int)
+    return write_strip(render_states(model, plan_qpos(model, kin, configs[lines]),
+                                     SNAPSHOT_SIZE), path)

@@ -6,6 +6,7 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 sys.path.insert(0, str(Path(__file__).parent))
@@ -93,6 +94,17 @@ def test_happy_path_writes_checkable_files_and_plots(fake_search, tmp_path, caps
     assert sc.seed == 7 and sc.rate_hz == 200.0
     pngs = sorted(plots.glob("stance_*.png"))
     assert len(pngs) == 1 and pngs[0].stat().st_size > 10_000  # one stance: both feet
+    strip = plots / "snapshots.png"
+    if strip.exists():
+        import imageio.v3 as iio
+
+        from ladders.render import SNAPSHOT_SIZE
+
+        image = iio.imread(strip)
+        assert image.shape[:2] == (SNAPSHOT_SIZE[1], 6 * SNAPSHOT_SIZE[0])
+        assert image.std() > 10  # a scene, not a blank frame
+    else:
+        assert "no snapshot strip" in cap.err
     assert check_plan.main([str(out), "--ladder", "drc", "--every", "25"]) == 0
 
 
@@ -113,3 +125,26 @@ def test_real_mount_plan_is_deterministic_and_checks(tmp_path):
                      "-o", str(path)]) == 0
     assert a.read_bytes() == b.read_bytes()
     assert check_plan.main([str(a), "--ladder", "drc", "--every", "5"]) == 0
+
+
+def test_plan_qpos_puts_the_scene_robot_where_the_planner_has_it():
+    # The strip draws planned configurations in MuJoCo: the feet and palms of the
+    # converted qpos must land where the planner's (pinocchio) model puts them.
+    import mujoco
+
+    from ladders.scene import build_scene
+    from planner.plots import plan_qpos
+
+    planner = ClimbPlanner(load_ladder("drc"), seed=1)
+    q, _ = planner.start_configuration()
+    q = q.copy()
+    q[planner.kin.q_index["LSP"]] = -0.7  # an asymmetric pose, so a swapped column shows
+    q[planner.kin.q_index["REB"]] = -1.1
+    model = build_scene(load_ladder("drc")).compile()
+    data = mujoco.MjData(model)
+    data.qpos[:] = plan_qpos(model, planner.kin, q[None])[0]
+    mujoco.mj_kinematics(model, data)
+    for site, frame in (("L_sole", "L_sole"), ("R_sole", "R_sole"), ("L_palm", "L_palm"),
+                        ("R_palm", "R_palm")):
+        np.testing.assert_allclose(data.site(site).xpos,
+                                   planner.kin.frame_pose(q, frame)[:3, 3], atol=1e-6)
