@@ -35,7 +35,7 @@ from planner.validity import FeasibilityChecker
 from primitives.hold_seeds import FloorSeed, RailSeed
 from primitives.library import climb_sequence
 from primitives.primitive import Step
-from robot.errors import HuboLadderError
+from robot.errors import HuboLadderError, InputError
 from robot.joints import ARM_JOINTS, FINGER_JOINTS, LEG_JOINTS
 from robot.kinematic_tree import FINGER_CLOSED_RAD
 
@@ -54,7 +54,14 @@ WRIST_FOLD_MARGIN_RAD = 0.05
 WRIST_FOLD_SCAN_STEP_RAD = 0.01
 #: Start posture [rad], per side (roll signs mirrored): knees a little bent (a straight
 #: knee is an IK singularity), arms in a ready pose forward and out, elbows bent.
-START_POSTURE = {"HP": -0.2, "KN": 0.4, "AP": -0.2, "SP": -0.5, "SR": 0.3, "EB": -1.2}
+#: Standing start postures [rad] (left side; roll joints mirrored), in order of preference:
+#: forearms forward, ready to reach; then arms hanging, for a steep ladder whose rungs
+#: come within a forearm of the chest, or rails that pass beside the elbows. The first
+#: that touches nothing is the start.
+START_POSTURES = (
+    {"HP": -0.2, "KN": 0.4, "AP": -0.2, "SP": -0.5, "SR": 0.3, "EB": -1.2},
+    {"HP": -0.2, "KN": 0.4, "AP": -0.2, "SP": 0.0, "SR": 0.15, "EB": -0.3},
+)
 
 
 @dataclass(frozen=True)
@@ -215,24 +222,40 @@ class ClimbPlanner:
 
     # ----------------------------------------------------------------------------------
     def start_configuration(self) -> tuple[np.ndarray, Stance]:
-        """Standing on the floor at the world origin, limbs slightly bent, hands open."""
+        """Standing on the floor at the world origin, limbs slightly bent, hands open, in
+        the first of `START_POSTURES` clear of the ladder.
+
+        Raises:
+            InputError: every start posture touches the ladder (the spec's placement puts
+                the ladder where the robot stands).
+        """
         kin = self.kin
-        q = pin.neutral(kin.model)
-        q[2] = kin.params.pelvis_height_m
-        for side, sign in (("L", 1.0), ("R", -1.0)):
-            for joint, v in START_POSTURE.items():
-                if side + joint in kin.q_index:
-                    q[kin.q_index[side + joint]] = sign * v if joint == "SR" else v
-        floor = {}
-        for limb, frame in (("left_foot", "L_sole"), ("right_foot", "R_sole")):
-            T = np.eye(4)
-            T[:3, 3] = kin.frame_pose(q, frame)[:3, 3] * [1, 1, 0]
-            floor[limb] = T
-        holds = tuple(make_hold(FloorSeed(limb), self.geom, kin.params, floor) for limb in floor)
-        stance = Stance(holds)
-        res = self._project(q, holds)
-        self._standing_pelvis_z_m = float(res[2])
-        return res, stance
+        hits = []
+        for posture in START_POSTURES:
+            q = pin.neutral(kin.model)
+            q[2] = kin.params.pelvis_height_m
+            for side, sign in (("L", 1.0), ("R", -1.0)):
+                for joint, v in posture.items():
+                    if side + joint in kin.q_index:
+                        q[kin.q_index[side + joint]] = sign * v if joint == "SR" else v
+            floor = {}
+            for limb, frame in (("left_foot", "L_sole"), ("right_foot", "R_sole")):
+                T = np.eye(4)
+                T[:3, 3] = kin.frame_pose(q, frame)[:3, 3] * [1, 1, 0]
+                floor[limb] = T
+            holds = tuple(make_hold(FloorSeed(limb), self.geom, kin.params, floor)
+                          for limb in floor)
+            stance = Stance(holds)
+            res = self._project(q, holds)
+            verdict = self.checker.check(res, stance, self._contacts(holds))
+            if verdict.ok or not verdict.reason.startswith("collision"):
+                self._standing_pelvis_z_m = float(res[2])
+                return res, stance
+            hits.append(verdict.reason.removeprefix("collision "))
+        raise InputError(
+            f"ladder '{self.spec.name}': placement_x_m = {self.spec.placement_x_m:g} m "
+            f"leaves the robot no room to stand in front of it (every start posture touches "
+            f"the ladder: {', '.join(hits)}); place the ladder farther away")
 
     def _project(self, q: np.ndarray, holds: tuple[Hold, ...]) -> np.ndarray:
         r = solve_ik(self.kin, q, holds, torso_R=self.torso_R)

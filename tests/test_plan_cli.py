@@ -148,3 +148,11 @@ def test_plan_qpos_puts_the_scene_robot_where_the_planner_has_it():
                         ("R_palm", "R_palm")):
         np.testing.assert_allclose(data.site(site).xpos,
                                    planner.kin.frame_pose(q, frame)[:3, 3], atol=1e-6)
+
+
+def test_ladder_placed_on_the_robot_exits_2_naming_the_placement(tmp_path, capsys):
+    inside = _spec_file(tmp_path, "inside", **{"x_m: 0.16": "x_m: -0.2"})
+    assert main([str(inside), "-o", str(tmp_path / "i.traj")]) == 2
+    err = capsys.readouterr().err
+    assert "placement_x_m = -0.2 m" in err and "farther away" in err
+    assert not (tmp_path / "i.traj").exists()

@@ -323,3 +323,20 @@ def test_rrt_fallback_holds_the_body(planner, standing):
     with pytest.raises(ValueError, match="differ only in the moving joints"):
         plan_limb_path(planner.kin, planner.checker, a, b, LEFT_ARM, stance,
                        {h.limb: h.target for h in stance.holds})
+
+
+def test_start_lowers_the_arms_where_the_rungs_are_within_reach_of_the_chest(planner):
+    from planner.search import START_POSTURES
+
+    def start_shoulder_pitch(p):
+        q, stance = p.start_configuration()
+        assert p.checker.check(q, stance, {h.limb: h.target for h in stance.holds}).ok
+        return q[p.kin.q_index["LSP"]]
+
+    # DRC (60°): forearms forward. A 74° ladder at the same placement: rung 2 is where
+    # the forward hands would be, so the robot starts with its arms hanging.
+    assert start_shoulder_pitch(planner) == pytest.approx(START_POSTURES[0]["SP"], abs=0.05)
+    steep = replace(load_ladder("drc"), slope_deg=74.2, rung_spacing_m=0.322,
+                    rail_spacing_m=0.816)
+    assert start_shoulder_pitch(ClimbPlanner(steep, seed=1)) == pytest.approx(
+        START_POSTURES[1]["SP"], abs=0.05)
