@@ -3,11 +3,12 @@ fails, plan the moving limb with OMPL (RRTConnect) in the constrained space").
 
 The constrained space is the moving limbs' joints with the rest of the body held: the
 supporting limbs then stay exactly on their holds, so every state is on the contact
-constraints without projection. RRTConnect (OMPL) searches that space with the planner's
-own feasibility test (joint limits, coal collisions, CoM and torque stability) as its
-validity checker; the path is then shortened greedily (straight segments checked at the
-planner's resolution) and sampled so that neighbours are within the resolution, every
-configuration checked again.
+constraints without projection. RRTConnect (OMPL) searches that space for a path clear of
+collisions within the joint limits (coal, ≈ 0.1 ms a state); the path is then shortened
+greedily and sampled so that neighbours are within the planner's resolution, and every
+configuration of it passes the planner's whole feasibility test (limits, collisions, CoM
+and torque stability: the LP costs ≈ 1.5 ms a state, too much for the search itself, and a
+limb moving in the air seldom changes what the stance can carry).
 
 Determinism: OMPL's random numbers come from one process-wide generator, which OMPL lets
 us seed only before its first draw; it is seeded then with a fixed seed, and the budget is
@@ -82,9 +83,12 @@ def plan_limb_path(kin: HuboKinematics, checker: FeasibilityChecker, q_from: np.
         q[idx] = x
         return q
 
-    def feasible(x) -> bool:
+    def clear(x) -> bool:
         checks[0] += 1
-        return bool(checker.check(configuration(x), stance, contacts).ok)
+        return bool(checker.collision_free(configuration(x), contacts))
+
+    def feasible(q) -> bool:
+        return bool(checker.check(q, stance, contacts).ok)
 
     space = ob.RealVectorStateSpace(len(idx))
     bounds = ob.RealVectorBounds(len(idx))
@@ -93,7 +97,7 @@ def plan_limb_path(kin: HuboKinematics, checker: FeasibilityChecker, q_from: np.
         bounds.setHigh(i, float(hi))
     space.setBounds(bounds)
     setup = og.SimpleSetup(space)
-    setup.setStateValidityChecker(lambda s: feasible([s[i] for i in range(len(idx))]))
+    setup.setStateValidityChecker(lambda s: clear([s[i] for i in range(len(idx))]))
     info = setup.getSpaceInformation()
     info.setStateValidityCheckingResolution(EDGE_CHECK_RAD / space.getMaximumExtent())
     start, goal = space.allocState(), space.allocState()
@@ -108,7 +112,7 @@ def plan_limb_path(kin: HuboKinematics, checker: FeasibilityChecker, q_from: np.
     path = setup.getSolutionPath()
     vertices = [np.array([path.getState(k)[i] for i in range(len(idx))])
                 for k in range(path.getStateCount())]
-    return _shortcut_and_sample(vertices, configuration, feasible, resolution_rad)
+    return _shortcut_and_sample(vertices, configuration, clear, feasible, resolution_rad)
 
 
 def _segment(a: np.ndarray, b: np.ndarray, resolution_rad: float) -> list[np.ndarray]:
@@ -117,19 +121,20 @@ def _segment(a: np.ndarray, b: np.ndarray, resolution_rad: float) -> list[np.nda
     return [a + (b - a) * (k / n) for k in range(1, n + 1)]
 
 
-def _shortcut_and_sample(vertices, configuration, feasible, resolution_rad):
+def _shortcut_and_sample(vertices, configuration, clear, feasible, resolution_rad):
     """Greedy shortcut: from each kept vertex, jump to the farthest later vertex whose
-    straight segment is feasible at ``resolution_rad``; the RRT's own edges are the
-    fallback (re-checked at that resolution, as they were only checked coarsely)."""
+    straight segment is clear at ``resolution_rad``; the RRT's own edges are the fallback
+    (re-checked at that resolution, as they were only checked coarsely). None when a
+    sample of the result fails the whole feasibility test."""
     out: list[np.ndarray] = []
     i = 0
     while i < len(vertices) - 1:
         for j in range(len(vertices) - 1, i, -1):
             seg = _segment(vertices[i], vertices[j], resolution_rad)
-            if all(feasible(x) for x in seg):
+            if all(clear(x) for x in seg):
                 out += [configuration(x) for x in seg]
                 i = j
                 break
         else:
-            return None  # an RRT edge infeasible at the fine resolution
-    return out
+            return None  # an RRT edge in collision at the fine resolution
+    return out if all(feasible(q) for q in out) else None

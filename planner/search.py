@@ -81,9 +81,9 @@ class PlannerConfig:
     # a position-controlled leg and a compliant arm really share differing from the LP's
     # optimum; at 0.85 the DRC mount has no solution, so the default is the limit itself.
     max_torque_ratio: float = 1.0
-    # The OMPL fallback (planner.limb_rrt): RRTConnect's budget in validity checks (the
-    # arms through a steep ladder's rungs took 14,000–26,000, ≈ 1 ms each), tried on at
-    # most this many samples of a step, as a failed search costs the whole budget.
+    # The OMPL fallback (planner.limb_rrt): RRTConnect's budget in collision checks
+    # (≈ 0.1 ms each; an arm through a steep ladder's rungs took up to 26,000), tried on
+    # at most this many samples of a step, as a failed search costs the whole budget.
     limb_rrt_max_checks: int = 30000
     limb_rrt_tries_per_step: int = 2
 

@@ -97,9 +97,7 @@ class FeasibilityChecker:
             contacts: limb → environment object it may touch (its held object, and for a
                 moving limb at the ends of its path the object it leaves or reaches).
         """
-        joints = q[7:]
-        if np.any(joints < self._lower - LIMIT_TOL_RAD) or np.any(joints > self._upper +
-                                                                 LIMIT_TOL_RAD):
+        if not self.within_limits(q):
             return Verdict(False, "joint limits", np.nan, np.nan)
         self.collision.allow(contacts)
         if self.collision.in_collision(q):
@@ -121,6 +119,19 @@ class FeasibilityChecker:
                    f"torque {ratio:.2f}× limit at {report.torque.worst_joint}")
             return Verdict(False, why, report.margin_m, ratio)
         return Verdict(True, "ok", report.margin_m, ratio)
+
+    def within_limits(self, q: np.ndarray) -> bool:
+        joints = q[7:]
+        return not (np.any(joints < self._lower - LIMIT_TOL_RAD)
+                    or np.any(joints > self._upper + LIMIT_TOL_RAD))
+
+    def collision_free(self, q: np.ndarray, contacts: dict[str, str]) -> bool:
+        """Within the joint limits and touching nothing but ``contacts`` (the first two
+        parts of `check`, without the stability test)."""
+        if not self.within_limits(q):
+            return False
+        self.collision.allow(contacts)
+        return not self.collision.in_collision(q)
 
     def holding_torques(self, q: np.ndarray, stance: Stance) -> TorqueCheck:
         """The torque LP's joint torques that hold ``q`` on ``stance`` (limits as `check`)."""
