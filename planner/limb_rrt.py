@@ -5,7 +5,8 @@ The constrained space is the moving limbs' joints with the rest of the body held
 supporting limbs then stay exactly on their holds, so every state is on the contact
 constraints without projection. RRTConnect (OMPL) searches that space for a path clear of
 collisions within the joint limits (coal, ≈ 0.1 ms a state); the path is then shortened
-greedily and sampled so that neighbours are within the planner's resolution, and every
+by OMPL's rope shortcut (deterministic) and sampled so that neighbours are within the
+planner's resolution, and every
 configuration of it passes the planner's whole feasibility test (limits, collisions, CoM
 and torque stability: the LP costs ≈ 1.5 ms a state, too much for the search itself, and a
 limb moving in the air seldom changes what the stance can carry).
@@ -74,8 +75,10 @@ def plan_limb_path(kin: HuboKinematics, checker: FeasibilityChecker, q_from: np.
         raise ValueError("plan_limb_path holds the body: q_from and q_to must differ only "
                          "in the moving joints")
     _seed_ompl()
-    lower = kin.model.lowerPositionLimit[idx]
-    upper = kin.model.upperPositionLimit[idx]
+    # The ends may sit a rounding error outside the limits (the planner's check allows
+    # that): OMPL would wait forever for a goal inside them.
+    lower = np.minimum(kin.model.lowerPositionLimit[idx], np.minimum(q_from[idx], q_to[idx]))
+    upper = np.maximum(kin.model.upperPositionLimit[idx], np.maximum(q_from[idx], q_to[idx]))
     checks = [0]
 
     def configuration(x) -> np.ndarray:
@@ -106,35 +109,27 @@ def plan_limb_path(kin: HuboKinematics, checker: FeasibilityChecker, q_from: np.
     setup.setStartAndGoalStates(start, goal)
     setup.setPlanner(og.RRTConnect(info))
     setup.setup()
-    solved = setup.solve(ob.PlannerTerminationCondition(lambda: checks[0] >= max_checks))
+    polls = [0]
+
+    def done() -> bool:
+        # Budget in checks; the poll count bounds loops that check nothing.
+        polls[0] += 1
+        return checks[0] >= max_checks or polls[0] >= 10 * max_checks
+
+    solved = setup.solve(ob.PlannerTerminationCondition(done))
     if not (solved and setup.haveExactSolutionPath()):
         return None
     path = setup.getSolutionPath()
+    og.PathSimplifier(info).ropeShortcutPath(path)  # deterministic, checks at the edge step
     vertices = [np.array([path.getState(k)[i] for i in range(len(idx))])
                 for k in range(path.getStateCount())]
-    return _shortcut_and_sample(vertices, configuration, clear, feasible, resolution_rad)
+    out = [configuration(x) for a, b in zip(vertices, vertices[1:], strict=False)
+           for x in _segment(a, b, resolution_rad)]
+    # OMPL checked edges every EDGE_CHECK_RAD: re-check every sample, with stability.
+    return out if all(feasible(q) for q in out) else None
 
 
 def _segment(a: np.ndarray, b: np.ndarray, resolution_rad: float) -> list[np.ndarray]:
     """Points from ``a`` (excluded) to ``b`` (included), steps ≤ resolution per joint."""
     n = max(1, int(np.ceil(np.max(np.abs(b - a)) / resolution_rad)))
     return [a + (b - a) * (k / n) for k in range(1, n + 1)]
-
-
-def _shortcut_and_sample(vertices, configuration, clear, feasible, resolution_rad):
-    """Greedy shortcut: from each kept vertex, jump to the farthest later vertex whose
-    straight segment is clear at ``resolution_rad``; the RRT's own edges are the fallback
-    (re-checked at that resolution, as they were only checked coarsely). None when a
-    sample of the result fails the whole feasibility test."""
-    out: list[np.ndarray] = []
-    i = 0
-    while i < len(vertices) - 1:
-        for j in range(len(vertices) - 1, i, -1):
-            seg = _segment(vertices[i], vertices[j], resolution_rad)
-            if all(clear(x) for x in seg):
-                out += [configuration(x) for x in seg]
-                i = j
-                break
-        else:
-            return None  # an RRT edge in collision at the fine resolution
-    return out if all(feasible(q) for q in out) else None
