@@ -340,3 +340,19 @@ def test_start_lowers_the_arms_where_the_rungs_are_within_reach_of_the_chest(pla
                     rail_spacing_m=0.816)
     assert start_shoulder_pitch(ClimbPlanner(steep, seed=1)) == pytest.approx(
         START_POSTURES[1]["SP"], abs=0.05)
+
+
+def test_rrt_fallback_takes_ends_a_rounding_error_past_a_limit(planner, standing):
+    # The planner's own check allows LIMIT_TOL past a limit; OMPL, given bounds that
+    # exclude the goal, used to wait for a valid goal forever.
+    from planner.limb_rrt import plan_limb_path
+    from robot.joints import LEFT_ARM
+
+    q, stance = standing
+    contacts = {h.limb: h.target for h in stance.holds}
+    b = q.copy()
+    i = planner.kin.q_index["LWY"]
+    b[i] = planner.kin.model.lowerPositionLimit[i] - 1e-9
+    assert planner.checker.check(b, stance, contacts).ok
+    path = plan_limb_path(planner.kin, planner.checker, q, b, LEFT_ARM, stance, contacts)
+    assert path is not None and np.array_equal(path[-1], b)
