@@ -83,9 +83,14 @@ class PlannerConfig:
     max_torque_ratio: float = 1.0
     # The OMPL fallback (planner.limb_rrt): RRTConnect's budget in collision checks
     # (≈ 0.1 ms each; an arm through a steep ladder's rungs took up to 26,000), tried on
-    # at most this many samples of a step, as a failed search costs the whole budget.
+    # at most this many samples of a step, as a failed search costs the whole budget, and
+    # only once this many samples of the step have failed. A pose whose arc collides sits
+    # near an obstacle; taken at once, such poses made later steps harder (DRC seeds 3
+    # and 4 timed out at 120 s, from 20/20 without the fallback), while a ladder that
+    # needs the fallback fails every sample anyway.
     limb_rrt_max_checks: int = 30000
-    limb_rrt_tries_per_step: int = 2
+    limb_rrt_tries_per_step: int = 4
+    limb_rrt_after_failures: int = 10
 
 
 class PlanningFailed(HuboLadderError):
@@ -497,6 +502,8 @@ class ClimbPlanner:
                 limb_path += self._interp(q_cur, q_next, support, support_stance, contacts,
                                           stats, moving=targets)
             except InterpolationError as exc:
+                if attempt < self.config.limb_rrt_after_failures:
+                    raise
                 limb_path += self._limb_detour(q_cur, q_next, moving_limbs, support,
                                                support_stance, contacts, stats, exc)
             q_cur = q_next
