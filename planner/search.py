@@ -84,13 +84,13 @@ class PlannerConfig:
     # The OMPL fallback (planner.limb_rrt): RRTConnect's budget in collision checks
     # (≈ 0.1 ms each; an arm through a steep ladder's rungs took up to 26,000), tried on
     # at most this many samples of a step, as a failed search costs the whole budget, and
-    # only once this many samples of the step have failed. A pose whose arc collides sits
-    # near an obstacle; taken at once, such poses made later steps harder (DRC seeds 3
-    # and 4 timed out at 120 s, from 20/20 without the fallback), while a ladder that
-    # needs the fallback fails every sample anyway.
+    # only in the last samples before the step gives up. A pose whose arc collides sits
+    # near an obstacle, and later steps from there are harder: taken at the first failure
+    # DRC seeds 3 and 4 timed out at 120 s, after 10 failures seeds 7 and 10 (20/20
+    # without the fallback), while a ladder that needs the fallback fails every sample.
     limb_rrt_max_checks: int = 30000
     limb_rrt_tries_per_step: int = 4
-    limb_rrt_after_failures: int = 10
+    limb_rrt_after_failures: int = 40
 
 
 class PlanningFailed(HuboLadderError):
