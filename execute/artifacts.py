@@ -12,7 +12,6 @@ Rendering needs an OpenGL context. If EGL is not available (no GPU driver, no Me
 
 from __future__ import annotations
 
-import logging
 import os
 from pathlib import Path
 
@@ -23,8 +22,6 @@ from robot.joints import ARM_JOINTS, joint_indices
 
 __all__ = ["RenderingUnavailable", "render_frames", "write_snapshot_strip",
            "write_tracking_plots", "write_video"]
-
-log = logging.getLogger(__name__)
 
 VIDEO_SIZE = (640, 480)  # [px]
 VIDEO_FPS = 30

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 import logging
+import os
 import sys
 import time
 from pathlib import Path
@@ -185,8 +186,6 @@ def main(argv: list[str] | None = None) -> int:
     except SystemExit as exc:  # argparse: --help (0) or a bad option (2)
         return int(exc.code or 0)
     if args.plots:
-        import os
-
         os.environ.setdefault("MUJOCO_GL", "egl")  # headless, before mujoco is imported
     err = Console(stderr=True)
     level = (logging.WARNING, logging.INFO, logging.DEBUG)[min(args.verbose, 2)]

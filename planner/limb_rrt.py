@@ -6,10 +6,10 @@ supporting limbs then stay exactly on their holds, so every state is on the cont
 constraints without projection. RRTConnect (OMPL) searches that space for a path clear of
 collisions within the joint limits (coal, ≈ 0.1 ms a state); the path is then shortened
 by OMPL's rope shortcut (deterministic) and sampled so that neighbours are within the
-planner's resolution, and every
-configuration of it passes the planner's whole feasibility test (limits, collisions, CoM
-and torque stability: the LP costs ≈ 1.5 ms a state, too much for the search itself, and a
-limb moving in the air seldom changes what the stance can carry).
+planner's resolution, and every configuration of it passes the planner's whole
+feasibility test (limits, collisions, CoM and torque stability: the LP costs ≈ 1.5 ms a
+state, too much for the search itself, and a limb moving in the air seldom changes what
+the stance can carry).
 
 Determinism: OMPL's random numbers come from one process-wide generator, which OMPL lets
 us seed only before its first draw; it is seeded then with a fixed seed, and the budget is
@@ -90,9 +90,6 @@ def plan_limb_path(kin: HuboKinematics, checker: FeasibilityChecker, q_from: np.
         checks[0] += 1
         return bool(checker.collision_free(configuration(x), contacts))
 
-    def feasible(q) -> bool:
-        return bool(checker.check(q, stance, contacts).ok)
-
     space = ob.RealVectorStateSpace(len(idx))
     bounds = ob.RealVectorBounds(len(idx))
     for i, (lo, hi) in enumerate(zip(lower, upper, strict=True)):
@@ -126,7 +123,7 @@ def plan_limb_path(kin: HuboKinematics, checker: FeasibilityChecker, q_from: np.
     out = [configuration(x) for a, b in zip(vertices, vertices[1:], strict=False)
            for x in _segment(a, b, resolution_rad)]
     # OMPL checked edges every EDGE_CHECK_RAD: re-check every sample, with stability.
-    return out if all(feasible(q) for q in out) else None
+    return out if all(checker.check(q, stance, contacts).ok for q in out) else None
 
 
 def _segment(a: np.ndarray, b: np.ndarray, resolution_rad: float) -> list[np.ndarray]:

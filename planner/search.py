@@ -234,33 +234,36 @@ class ClimbPlanner:
             InputError: every start posture touches the ladder (the spec's placement puts
                 the ladder where the robot stands).
         """
-        kin = self.kin
         hits = []
         for posture in START_POSTURES:
-            q = pin.neutral(kin.model)
-            q[2] = kin.params.pelvis_height_m
-            for side, sign in (("L", 1.0), ("R", -1.0)):
-                for joint, v in posture.items():
-                    if side + joint in kin.q_index:
-                        q[kin.q_index[side + joint]] = sign * v if joint == "SR" else v
-            floor = {}
-            for limb, frame in (("left_foot", "L_sole"), ("right_foot", "R_sole")):
-                T = np.eye(4)
-                T[:3, 3] = kin.frame_pose(q, frame)[:3, 3] * [1, 1, 0]
-                floor[limb] = T
-            holds = tuple(make_hold(FloorSeed(limb), self.geom, kin.params, floor)
-                          for limb in floor)
-            stance = Stance(holds)
-            res = self._project(q, holds)
-            verdict = self.checker.check(res, stance, self._contacts(holds))
+            q, stance = self._standing(posture)
+            verdict = self.checker.check(q, stance, self._contacts(stance.holds))
             if verdict.ok or not verdict.reason.startswith("collision"):
-                self._standing_pelvis_z_m = float(res[2])
-                return res, stance
+                self._standing_pelvis_z_m = float(q[2])
+                return q, stance
             hits.append(verdict.reason.removeprefix("collision "))
         raise InputError(
             f"ladder '{self.spec.name}': placement_x_m = {self.spec.placement_x_m:g} m "
             f"leaves the robot no room to stand in front of it (every start posture touches "
             f"the ladder: {', '.join(hits)}); place the ladder farther away")
+
+    def _standing(self, posture: dict[str, float]) -> tuple[np.ndarray, Stance]:
+        """The robot standing at the world origin in ``posture`` (left side; roll joints
+        mirrored), its feet flat on the floor where they fall."""
+        kin = self.kin
+        q = pin.neutral(kin.model)
+        q[2] = kin.params.pelvis_height_m
+        for side, sign in (("L", 1.0), ("R", -1.0)):
+            for joint, v in posture.items():
+                if side + joint in kin.q_index:
+                    q[kin.q_index[side + joint]] = sign * v if joint == "SR" else v
+        floor = {}
+        for limb, frame in (("left_foot", "L_sole"), ("right_foot", "R_sole")):
+            T = np.eye(4)
+            T[:3, 3] = kin.frame_pose(q, frame)[:3, 3] * [1, 1, 0]
+            floor[limb] = T
+        holds = tuple(make_hold(FloorSeed(limb), self.geom, kin.params, floor) for limb in floor)
+        return self._project(q, holds), Stance(holds)
 
     def _project(self, q: np.ndarray, holds: tuple[Hold, ...]) -> np.ndarray:
         r = solve_ik(self.kin, q, holds, torso_R=self.torso_R)
@@ -368,34 +371,37 @@ class ClimbPlanner:
         return path
 
     def _limb_detour(self, qa, qb, limbs, support, stability, contacts, stats: StepStats,
-                     exc: InterpolationError) -> list[np.ndarray]:
+                     exc: InterpolationError, attempt: int) -> list[np.ndarray]:
         """The OMPL fallback (`planner.limb_rrt`) where the arc between two way-point
-        configurations collides: the body moves to ``qb``'s with the moving limbs' joints
-        held (contact-space interpolation), then RRTConnect moves one limb at a time with
-        everything else held (a 7- or 6-joint space each, not all moving limbs at once).
-        Re-raises ``exc`` when that finds nothing or the arc failed otherwise."""
-        if (not exc.reason.startswith("midpoint infeasible: collision")
-                or stats.limb_detour_tries >= self.config.limb_rrt_tries_per_step):
+        configurations collides, in a step's last samples (`PlannerConfig`): the body
+        moves to ``qb``'s with the moving limbs' joints held (contact-space
+        interpolation), then RRTConnect moves one limb at a time with everything else held
+        (a 7- or 6-joint space each, not all moving limbs at once). Re-raises ``exc`` when
+        the fallback is not due or finds nothing."""
+        cfg = self.config
+        if (attempt < cfg.limb_rrt_after_failures
+                or stats.limb_detour_tries >= cfg.limb_rrt_tries_per_step
+                or not exc.reason.startswith("midpoint infeasible: collision")):
             raise exc
         stats.limb_detour_tries += 1
-        limb_idx = {limb: [self.kin.q_index[n] for n in self._limb_joints(limb)]
-                    for limb in limbs}
+        joints = {limb: self._limb_joints(limb) for limb in limbs}
         q_cur = qb.copy()
-        for idx in limb_idx.values():
+        for names in joints.values():
+            idx = [self.kin.q_index[n] for n in names]
             q_cur[idx] = qa[idx]
         if not self.checker.check(q_cur, stability, contacts).ok:
             raise exc
         path = (self._interp(qa, q_cur, support, stability, contacts, stats)
                 if self.kin.joint_distance(qa, q_cur) > 0 else [])
-        for limb, idx in limb_idx.items():
+        for names in joints.values():
             q_next = q_cur.copy()
+            idx = [self.kin.q_index[n] for n in names]
             q_next[idx] = qb[idx]
             if self.kin.joint_distance(q_cur, q_next) == 0:
                 continue
-            part = plan_limb_path(self.kin, self.checker, q_cur, q_next,
-                                  self._limb_joints(limb), stability, contacts,
-                                  resolution_rad=self.config.resolution_rad,
-                                  max_checks=self.config.limb_rrt_max_checks)
+            part = plan_limb_path(self.kin, self.checker, q_cur, q_next, names, stability,
+                                  contacts, resolution_rad=cfg.resolution_rad,
+                                  max_checks=cfg.limb_rrt_max_checks)
             if part is None:
                 raise exc
             path += part
@@ -502,10 +508,8 @@ class ClimbPlanner:
                 limb_path += self._interp(q_cur, q_next, support, support_stance, contacts,
                                           stats, moving=targets)
             except InterpolationError as exc:
-                if attempt < self.config.limb_rrt_after_failures:
-                    raise
                 limb_path += self._limb_detour(q_cur, q_next, moving_limbs, support,
-                                               support_stance, contacts, stats, exc)
+                                               support_stance, contacts, stats, exc, attempt)
             q_cur = q_next
         segments.append(PathSegment(step, "limb", support, moving_limbs, limb_path))
 
