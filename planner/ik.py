@@ -64,6 +64,26 @@ def _grip_axis(hold_T: np.ndarray) -> np.ndarray:
     return hold_T[:3, 0]
 
 
+#: placo's AxisAlignTask builds its error frame from ``cross(current, target).normalized()``,
+#: a zero vector when the two axes are exactly parallel or opposite: the QP then holds NaN
+#: and every solve from that state fails. A way-point taken from the hand's current pose
+#: (backing off its rail) starts exactly there; on the ship ladder (seeds 12 and 13) every
+#: sample of a hand move failed so. Such a target is turned by this angle, far below any
+#: tolerance.
+AXIS_ALIGN_NUDGE_RAD = 1e-6
+
+
+def _axis_target(current: np.ndarray, target: np.ndarray) -> np.ndarray:
+    """``target``, turned by `AXIS_ALIGN_NUDGE_RAD` if it is exactly (anti)parallel to the
+    frame's ``current`` axis (both unit vectors)."""
+    if np.linalg.norm(np.cross(current, target)) > 1e-12:
+        return target
+    perpendicular = np.cross(target, np.eye(3)[int(np.argmin(np.abs(target)))])
+    perpendicular /= np.linalg.norm(perpendicular)
+    return (np.cos(AXIS_ALIGN_NUDGE_RAD) * target
+            + np.sin(AXIS_ALIGN_NUDGE_RAD) * perpendicular)
+
+
 def _hold_error(kin: HuboKinematics, limb_frame: str, T_target: np.ndarray,
                 is_hand: bool) -> tuple[float, float]:
     T = kin.wrapper.get_T_world_frame(limb_frame)
@@ -169,14 +189,15 @@ def _add_hold_task(solver, hold: Hold, priority: str, w_pos: float, w_ori: float
                    preferences: bool) -> None:
     name = hold.limb
     if hold.is_hand:
+        R_now = solver.robot.get_T_world_frame(hold.frame)[:3, :3]
         t = solver.add_position_task(hold.frame, hold.T_world_frame[:3, 3].copy())
         t.configure(f"{name}_position", priority, w_pos)
         a = solver.add_axisalign_task(hold.frame, np.array([1.0, 0.0, 0.0]),
-                                      _grip_axis(hold.T_world_frame).copy())
+                                      _axis_target(R_now[:, 0], _grip_axis(hold.T_world_frame)))
         a.configure(f"{name}_grip_axis", priority, w_ori)
         if preferences:  # open side of the hand towards the ladder: soft, a preference
             b = solver.add_axisalign_task(hold.frame, np.array([0.0, 1.0, 0.0]),
-                                          hold.T_world_frame[:3, 1].copy())
+                                          _axis_target(R_now[:, 1], hold.T_world_frame[:3, 1]))
             b.configure(f"{name}_open_side", "soft", 0.1)
     else:
         t = solver.add_frame_task(hold.frame, hold.T_world_frame.copy())

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from ladders.loader import load_ladder
-from planner.contacts import Stance
+from planner.contacts import Hold, Stance
 from planner.ik import solve_ik
 from planner.interpolation import InterpolationError, contact_space_interpolate
 from planner.search import ClimbPlanner, PlannerConfig, PlanningFailed, StepStats
@@ -56,6 +56,17 @@ def test_projection_keeps_contact_frames_on_their_holds(planner, standing):
     drift = max(np.linalg.norm(planner.kin.frame_pose(mid, h.frame)[:3, 3]
                                - h.T_world_frame[:3, 3]) for h in stance.holds)
     assert drift > 1e-3
+
+
+def test_a_hand_target_at_the_hand_s_own_pose_is_solved(planner, standing):
+    """placo's axis-align task is singular at exactly zero error (NaN in the QP): a hand
+    way-point taken from the hand's current pose, as when it backs off its rail, must
+    still solve. On the ship ladder it failed every sample of a step (seeds 12 and 13)."""
+    q, stance = standing
+    hand = Hold("left_hand", "rail_left", np.eye(4), np.zeros((2, 3)), np.zeros((2, 3)), 0.4)
+    here = replace(hand, T_world_frame=planner.kin.frame_pose(q, hand.frame))
+    r = solve_ik(planner.kin, q, stance.holds, (here,), torso_R=planner.torso_R)
+    assert r.converged and r.position_error_m < 1e-4
 
 
 @pytest.mark.parametrize("resolution", [0.01, 0.04])
