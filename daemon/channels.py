@@ -22,31 +22,33 @@ Two implementations behind the one interface:
     never hides its previous sample;
   - slots are claimed with Linux open-file-description locks (``F_OFD_SETLK``), which the
     kernel drops when a process dies, so a killed writer's slot is free for the next one;
-  - a blocked reader sleeps in ``poll`` on an abstract-namespace UNIX datagram socket
-    (``@hubo-ladder/<instance>/<name>/r<k>``); it raises a "waiting" byte first, and a
-    writer sends each waiting reader a one-byte datagram naming the slot it just
-    published, so the woken reader copies that slot without scanning. Abstract sockets
-    vanish with their process: nothing to clean up after a crash. A lost wake-up
-    (theoretically possible; the fence is a lock round trip) costs at most
-    ``WAKE_SLICE_S``: a waiting reader re-checks the slots that often;
+  - a blocked reader sleeps on a futex: a 32-bit generation word in the file that every
+    write bumps after publishing, next to the index of the slot it published. The reader
+    raises its "waiting" byte, reads the generation, checks the slots and only then
+    sleeps, and only while the generation is unchanged, so a write in between is never
+    missed. A writer that sees a waiting byte wakes every sleeper with one system call,
+    and a woken reader copies the slot named there without scanning. A waiting reader
+    still re-checks the slots every ``WAKE_SLICE_S``. Futexes on a shared mapping need
+    nothing cleaned up after a crash;
   - `cleanup_stale` removes channel files no live process has open (the daemon calls it
     at start-up).
 
-Why not iceoryx2 (0.10.0, the maintained IPC library the issue suggested)? Measured with
-``bench/bench_channels.py`` on the project VM (2 cores, with other jobs using one or both),
-two processes, the ``ref`` struct (421 bytes then, 741 now), write → blocked reader wakes,
-median / p99:
+Why not iceoryx2 (0.10.0, the maintained IPC library the issue suggested), and why a
+futex? Measured with ``bench/bench_channels.py`` on the project VM (2 cores), two
+processes, the ``ref`` struct, write → blocked reader wakes, median / p99:
 
-| mechanism | quieter run | busier run |
-|---|---|---|
-| this module | 16.4 / 51 µs | 38–43 / ~720 µs |
-| iceoryx2 pub/sub + event service | 35.1 / 650 µs | 65–68 / 170–570 µs |
-| bare datagram, no data (OS floor) | 8.0 µs | 13–24 µs |
+| mechanism | measured |
+|---|---|
+| this module, futex wake (741 B) | 16.5–19 µs / 71–83 µs (5 runs; one outlier 29 / 181) |
+| this module, earlier: a UNIX datagram per waiting reader | 18.7–20 µs / 75–103 µs (*) |
+| iceoryx2 pub/sub + event service (421 B, earlier session) | 35.1 / 650 µs |
+| a bare futex wake with no data, two Python processes | 12.2–12.5 µs / 42–57 µs |
+| bare datagram, no data (the bench's OS floor) | 10–21 µs, varying with the VM's load |
 
-iceoryx2's wake-up path (its event service, then draining every publisher) costs two to
-three times this module's overhead over the OS floor, and adds a Rust extension and files
-under ``/tmp/iceoryx2``. Neither meets the 11 µs median target on this machine; the
-floor alone takes most of it there. On a quiet core expect roughly floor + 8 µs.
+(*) the same 5 runs, interleaved with the futex ones; one outlier 29.8 / 101 µs.
+
+None meets the 11 µs median target on this machine: the bare wake-up alone takes
+12 µs here, and the rest (stamping, the 741-byte copies, the seqlock) is Python.
 
 The seqlock assumes x86-64's store ordering (TSO); on weakly ordered CPUs (aarch64) the
 counter re-check needs real barriers. Do not fork a process that holds a channel open:
@@ -56,15 +58,14 @@ the child shares its open file description, and so its locks.
 from __future__ import annotations
 
 import abc
+import ctypes
 import errno
 import fcntl
 import logging
-import math
 import mmap
 import os
+import platform
 import re
-import select
-import socket
 import struct
 import threading
 import time
@@ -228,8 +229,10 @@ def reset_in_process(instance: str) -> None:
 # ---------------------------------------------------------------- shared memory
 
 _MAGIC = b"HUBOCHN1"
-_VERSION = 1
+_VERSION = 2
 _HDR = struct.Struct("<8sIIIIQ")  # magic, version, sample_size, writers, readers, dtype crc
+_GENERATION_OFF = 48  # u32 futex word: bumped after every publish
+_LAST_SLOT_OFF = 52  # u8: the writer slot published last
 _WAIT_OFF = 64  # MAX_READERS "waiting" bytes
 _TABLE_OFF = 128  # per writer slot, 8 × i64: counter, time_ns, seq, writer_id, buffer, pad
 _ROW_Q = 8
@@ -247,6 +250,27 @@ _ROW_BODY = struct.Struct("<qqqq")  # time_ns, seq, writer_id, buffer (after the
 _ROW_HEAD = struct.Struct("<qq")  # counter, time_ns
 _FLOCK = struct.Struct("hhqqi4x")  # struct flock on Linux x86-64 / aarch64
 _ODD_SPIN = 2000  # reads of an odd counter before the slot is taken as stuck (dead writer)
+
+_LIBC = ctypes.CDLL(None, use_errno=True)
+_SYS_FUTEX = {"x86_64": 202, "aarch64": 98}.get(platform.machine())
+_FUTEX_WAIT, _FUTEX_WAKE = 0, 1  # shared (not FUTEX_PRIVATE): the word is in a file mapping
+_WAKE_ALL = 0x7FFFFFFF
+
+
+class _Timespec(ctypes.Structure):
+    _fields_ = [("tv_sec", ctypes.c_long), ("tv_nsec", ctypes.c_long)]
+
+
+def _futex_wait(addr: int, expected: int, timeout_s: float) -> None:
+    """Sleep while the u32 at ``addr`` equals ``expected``, at most ``timeout_s``; returns on
+    a wake, a changed value (EAGAIN), the timeout or a signal alike: the caller re-checks."""
+    ts = _Timespec(int(timeout_s), int((timeout_s % 1.0) * 1e9))
+    _LIBC.syscall(_SYS_FUTEX, ctypes.c_void_p(addr), _FUTEX_WAIT, ctypes.c_uint32(expected),
+                  ctypes.byref(ts), None, 0)
+
+
+def _futex_wake_all(addr: int) -> None:
+    _LIBC.syscall(_SYS_FUTEX, ctypes.c_void_p(addr), _FUTEX_WAKE, _WAKE_ALL, None, None, 0)
 
 
 def _ofd_lock(fd: int, kind: int, start: int, wait: bool = False) -> bool:
@@ -286,8 +310,8 @@ class ShmChannel(Channel):
 
     Args:
         name: channel name (letters, digits, ``_``, ``-``).
-        instance: daemon instance name; namespaces the file and socket names so that
-            parallel daemons and tests never collide.
+        instance: daemon instance name; namespaces the file names so that parallel
+            daemons and tests never collide.
         dtype: struct dtype; defaults to `daemon.structs.CHANNEL_DTYPES` [name].
         writer_id: see `Channel`.
 
@@ -314,13 +338,12 @@ class ShmChannel(Channel):
         self._mm: mmap.mmap | None = None
         self._wslot: int | None = None
         self._rslot: int | None = None
-        self._rsock: socket.socket | None = None
-        self._wsock: socket.socket | None = None
+        self._generation: ctypes.c_uint32 | None = None  # the futex word, in the mapping
         self._stuck: dict[int, int] = {}  # slot → counter seen odd for too long
         self._fence = threading.Lock()
-        self._addrs = [
-            f"\0hubo-ladder/{instance}/{name}/r{k}".encode() for k in range(MAX_READERS)
-        ]
+        if _SYS_FUTEX is None:
+            raise ChannelError(f"shared-memory channels need Linux futexes on x86-64 or "
+                               f"aarch64, not {platform.machine()}")
         try:
             self._open_segment()
         except BaseException:
@@ -358,6 +381,8 @@ class ShmChannel(Channel):
             _ofd_lock(fd, fcntl.F_UNLCK, _LOCK_INIT)
         self._mm = mmap.mmap(fd, total)
         self._mv = memoryview(self._mm)
+        self._generation = ctypes.c_uint32.from_buffer(self._mm, _GENERATION_OFF)
+        self._generation_addr = ctypes.addressof(self._generation)
 
     def _claim_writer_slot(self) -> int:
         for i in range(MAX_WRITERS):
@@ -368,34 +393,20 @@ class ShmChannel(Channel):
                     log.warning("%s: writer slot %d was torn by a dead writer", self.path, i)
                     _ROW_BODY.pack_into(self._mm, off + 8, 0, 0, 0, 0)
                     _COUNTER.pack_into(self._mm, off, counter + 1)
-                self._wsock = socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM)
-                self._wsock.setblocking(False)
                 self._counter, *_, self._buffer = _ROW_HEAD.unpack_from(self._mm, off) + (
                     _ROW_BODY.unpack_from(self._mm, off + 8)
                 )
                 self._table_off = off
                 self._data_off = _DATA_OFF + 2 * i * self._stride
-                self._note = bytes([i])
                 self._wslot = i
                 return i
         raise ChannelError(f"{self.path}: all {MAX_WRITERS} writer slots are in use")
 
     def _claim_reader_slot(self) -> int:
         for k in range(MAX_READERS):
-            if not _ofd_lock(self._fd, fcntl.F_WRLCK, _LOCK_READER + k):
-                continue
-            sock = socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM)
-            try:
-                sock.bind(self._addrs[k])
-            except OSError:  # still bound by a forked child of the last holder
-                sock.close()
-                _ofd_lock(self._fd, fcntl.F_UNLCK, _LOCK_READER + k)
-                continue
-            sock.setblocking(False)
-            self._poll = select.poll()
-            self._poll.register(sock.fileno(), select.POLLIN)
-            self._rsock, self._rslot = sock, k
-            return k
+            if _ofd_lock(self._fd, fcntl.F_WRLCK, _LOCK_READER + k):
+                self._rslot = k
+                return k
         raise ChannelError(f"{self.path}: all {MAX_READERS} reader slots are in use")
 
     # -- data
@@ -417,17 +428,13 @@ class ShmChannel(Channel):
         _ROW_BODY.pack_into(mm, off + 8, t_ns, self._seq, self.writer_id, buffer)
         _COUNTER.pack_into(mm, off, counter + 2)
         self._counter, self._buffer = counter + 2, buffer
+        mm[_LAST_SLOT_OFF] = self._wslot  # tells a woken reader which slot to copy
+        generation = self._generation
+        generation.value = (generation.value + 1) & 0xFFFFFFFF
         with self._fence:  # full barrier (locked instruction) before reading the flags
             pass
-        waiting = mm[_WAIT_OFF : _WAIT_OFF + MAX_READERS]
-        if waiting != _NOBODY_WAITING:
-            k = waiting.find(1)
-            while k >= 0:
-                try:  # the note tells the reader which slot is the newest
-                    self._wsock.sendto(self._note, self._addrs[k])
-                except OSError:  # reader gone or its queue full: it will re-check
-                    pass
-                k = waiting.find(1, k + 1)
+        if mm[_WAIT_OFF : _WAIT_OFF + MAX_READERS] != _NOBODY_WAITING:
+            _futex_wake_all(self._generation_addr)
         return t_ns
 
     def _newest(self) -> tuple[int, tuple[int, int, int], int] | None:
@@ -487,24 +494,20 @@ class ShmChannel(Channel):
                 return None
             if self._rslot is None:
                 self._claim_reader_slot()
-            self._drain()
             self._mm[_WAIT_OFF + self._rslot] = 1
             with self._fence:
                 pass
+            generation = self._generation.value
             latest = self.read_latest()
             if latest is not None and int(latest["time_ns"]) > last_seq:
                 self._mm[_WAIT_OFF + self._rslot] = 0
                 return latest
-            # poll() with a millisecond timeout wakes ~5 µs sooner than SO_RCVTIMEO or
-            # select() (measured); the deadline check bounds the rounding.
-            if self._poll.poll(math.ceil(min(remaining, WAKE_SLICE_S) * 1000)):
-                # Fast path: the note names the slot just written, the newest one.
-                try:
-                    note = self._rsock.recv(1)
-                except (BlockingIOError, InterruptedError):
-                    note = b""
-                if note and note[0] < MAX_WRITERS:
-                    i = note[0]
+            # A write after the generation was read changes it: the futex does not sleep.
+            _futex_wait(self._generation_addr, generation, min(remaining, WAKE_SLICE_S))
+            if self._generation.value != generation:
+                # Fast path: the slot published last, the newest one.
+                i = self._mm[_LAST_SLOT_OFF]
+                if i < MAX_WRITERS:
                     row = _TABLE_OFF + 8 * _ROW_Q * i
                     counter, t_ns = _ROW_HEAD.unpack_from(self._mm, row)
                     if not counter & 1 and t_ns > last_seq:
@@ -516,21 +519,12 @@ class ShmChannel(Channel):
             self._mm[_WAIT_OFF + self._rslot] = 0
             latest = self.read_latest()
 
-    def _drain(self) -> None:
-        try:
-            while True:
-                self._rsock.recv(1)
-        except (BlockingIOError, InterruptedError):
-            pass
-
     def close(self) -> None:
         if self._fd < 0:
             return
-        if self._rsock is not None:
+        if self._rslot is not None:
             self._mm[_WAIT_OFF + self._rslot] = 0
-            self._rsock.close()
-        if self._wsock is not None:
-            self._wsock.close()
+        self._generation = None  # a live ctypes view would keep the mapping from closing
         self._mv.release()
         self._mm.close()
         os.close(self._fd)  # drops every OFD lock of this object
