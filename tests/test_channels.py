@@ -132,6 +132,29 @@ def test_wait_newer_times_out_and_wakes(instance, in_process):
     w.close()
 
 
+def test_a_blocked_reader_is_woken_by_each_write_not_by_its_re_check(instance, monkeypatch):
+    """Every write wakes a blocked shared-memory reader: with the periodic re-check pushed
+    out to 30 s, a lost wake-up leaves ``wait_newer`` asleep for its whole 10 s timeout
+    (the bound below is 2,500 times a wake-up). Writes land at random moments around the
+    reader's check-then-sleep."""
+    monkeypatch.setattr(ch, "WAKE_SLICE_S", 30.0)
+    r, w = ShmChannel("ref", instance), ShmChannel("ref", instance)
+    stamp = w.write(_ref(0.0))
+    delays = np.random.default_rng(0).uniform(0.0, 0.002, 200)
+    for k, delay in enumerate(delays, start=1):
+        timer = threading.Timer(delay, w.write, args=(_ref(float(k)),))
+        timer.start()
+        t0 = time.monotonic()
+        got = r.wait_newer(stamp, 10.0)
+        waited_s = time.monotonic() - t0
+        timer.join()
+        assert got is not None and float(got["ref"][0]) == k
+        assert waited_s < 5.0, f"write {k} did not wake the reader"
+        stamp = int(got["time_ns"])
+    r.close()
+    w.close()
+
+
 def test_other_structs_and_errors(instance):
     c = ShmChannel("state", instance)
     s = new_sample(STATE_DTYPE)
