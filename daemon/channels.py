@@ -252,6 +252,7 @@ _FLOCK = struct.Struct("hhqqi4x")  # struct flock on Linux x86-64 / aarch64
 _ODD_SPIN = 2000  # reads of an odd counter before the slot is taken as stuck (dead writer)
 
 _LIBC = ctypes.CDLL(None, use_errno=True)
+#: syscall() is variadic: the number is passed as a C long, not a promoted int.
 _SYS_FUTEX = {"x86_64": 202, "aarch64": 98}.get(platform.machine())
 _FUTEX_WAIT, _FUTEX_WAKE = 0, 1  # shared (not FUTEX_PRIVATE): the word is in a file mapping
 _WAKE_ALL = 0x7FFFFFFF
@@ -265,12 +266,13 @@ def _futex_wait(addr: int, expected: int, timeout_s: float) -> None:
     """Sleep while the u32 at ``addr`` equals ``expected``, at most ``timeout_s``; returns on
     a wake, a changed value (EAGAIN), the timeout or a signal alike: the caller re-checks."""
     ts = _Timespec(int(timeout_s), int((timeout_s % 1.0) * 1e9))
-    _LIBC.syscall(_SYS_FUTEX, ctypes.c_void_p(addr), _FUTEX_WAIT, ctypes.c_uint32(expected),
-                  ctypes.byref(ts), None, 0)
+    _LIBC.syscall(ctypes.c_long(_SYS_FUTEX), ctypes.c_void_p(addr), _FUTEX_WAIT,
+                  ctypes.c_uint32(expected), ctypes.byref(ts), None, 0)
 
 
 def _futex_wake_all(addr: int) -> None:
-    _LIBC.syscall(_SYS_FUTEX, ctypes.c_void_p(addr), _FUTEX_WAKE, _WAKE_ALL, None, None, 0)
+    _LIBC.syscall(ctypes.c_long(_SYS_FUTEX), ctypes.c_void_p(addr), _FUTEX_WAKE, _WAKE_ALL,
+                  None, None, 0)
 
 
 def _ofd_lock(fd: int, kind: int, start: int, wait: bool = False) -> bool:
