@@ -23,7 +23,8 @@ Two implementations behind the one interface:
   - slots are claimed with Linux open-file-description locks (``F_OFD_SETLK``), which the
     kernel drops when a process dies, so a killed writer's slot is free for the next one;
   - a blocked reader sleeps on a futex: a 32-bit generation word in the file that every
-    write bumps after publishing, next to the index of the slot it published. The reader
+    write sets to its time stamp's low bits after publishing, next to the index of the
+    slot it published. The reader
     raises its "waiting" byte, reads the generation, checks the slots and only then
     sleeps, and only while the generation is unchanged, so a write in between is never
     missed. A writer that sees a waiting byte wakes every sleeper with one system call,
@@ -231,7 +232,7 @@ def reset_in_process(instance: str) -> None:
 _MAGIC = b"HUBOCHN1"
 _VERSION = 2
 _HDR = struct.Struct("<8sIIIIQ")  # magic, version, sample_size, writers, readers, dtype crc
-_GENERATION_OFF = 48  # u32 futex word: bumped after every publish
+_GENERATION_OFF = 48  # u32 futex word: low bits of the last publish's time_ns
 _LAST_SLOT_OFF = 52  # u8: the writer slot published last
 _WAIT_OFF = 64  # MAX_READERS "waiting" bytes
 _TABLE_OFF = 128  # per writer slot, 8 × i64: counter, time_ns, seq, writer_id, buffer, pad
@@ -431,8 +432,9 @@ class ShmChannel(Channel):
         _COUNTER.pack_into(mm, off, counter + 2)
         self._counter, self._buffer = counter + 2, buffer
         mm[_LAST_SLOT_OFF] = self._wslot  # tells a woken reader which slot to copy
-        generation = self._generation
-        generation.value = (generation.value + 1) & 0xFFFFFFFF
+        # A store, not an increment: two writers' read-modify-writes could race to the same
+        # value, and a reader that read it in between would sleep through the second write.
+        self._generation.value = t_ns & 0xFFFFFFFF
         with self._fence:  # full barrier (locked instruction) before reading the flags
             pass
         if mm[_WAIT_OFF : _WAIT_OFF + MAX_READERS] != _NOBODY_WAITING:
