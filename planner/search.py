@@ -384,18 +384,17 @@ class ClimbPlanner:
                 or not exc.reason.startswith("midpoint infeasible: collision")):
             raise exc
         stats.limb_detour_tries += 1
-        joints = {limb: self._limb_joints(limb) for limb in limbs}
+        joints = [(names, [self.kin.q_index[n] for n in names])
+                  for names in map(self._limb_joints, limbs)]
         q_cur = qb.copy()
-        for names in joints.values():
-            idx = [self.kin.q_index[n] for n in names]
+        for _, idx in joints:
             q_cur[idx] = qa[idx]
         if not self.checker.check(q_cur, stability, contacts).ok:
             raise exc
         path = (self._interp(qa, q_cur, support, stability, contacts, stats)
                 if self.kin.joint_distance(qa, q_cur) > 0 else [])
-        for names in joints.values():
+        for names, idx in joints:
             q_next = q_cur.copy()
-            idx = [self.kin.q_index[n] for n in names]
             q_next[idx] = qb[idx]
             if self.kin.joint_distance(q_cur, q_next) == 0:
                 continue
