@@ -22,7 +22,15 @@ When it lets go:
 
 - the fingers are commanded open (sent reference below ``open_fraction`` · closed);
 - the finger board tripped (no finger torque, no grip);
-- the weld's load exceeds the grip's capacity for ``slip_persistence_s`` (a slip).
+- the load across the rail (radial force or bending torque, which pull the rail out of
+  the fingers or pry them open) exceeds the grip's capacity for ``slip_persistence_s``.
+
+When it slips, still latched: a closed hand on a round rail turns about it or slides
+along it once the load in that direction exceeds what friction holds, as a real grip
+does; the fingers stay round the rail. Each tick such a load is over capacity, the
+weld's anchor is moved about (or along) the rail, by the share of the hand's offset
+from it that leaves the weld's spring carrying only the capacity. `slip_rad` and
+`slip_m` add up how far the hand turned and slid.
 
 Grip capacity, from the fingers' torque limit (hubo-facts §5: ≈ 5 N·m each):
 
@@ -41,6 +49,11 @@ along the grip axis (±36, ±18, 0 mm), ``μ`` the ladder's friction. The load i
 weld's constraint wrench on the hand, about the palm site, split along and across the
 rail. ``slip_persistence_s = 10 ms`` (two ticks) only filters single-step constraint
 spikes at impacts; it is not a tuning knob.
+
+A hand that held by the weld's full stiffness in all six directions would carry whatever
+twist the arm gives it until the latch let go: a compliant arm at a near-singular wrist,
+moved by the body's centimetre of sag, twisted a DRC grip past 8.3 N·m about its rail
+and the hand dropped a rail it was still closed on.
 """
 
 from __future__ import annotations
@@ -54,7 +67,8 @@ import numpy as np
 
 from robot.kinematic_tree import FINGER_CLOSED_RAD
 
-__all__ = ["GraspEvent", "GraspLatch", "GripCapacity", "GripConfig", "GripState"]
+__all__ = ["RELEASE_LOADS", "SLIP_LOADS", "GraspEvent", "GraspLatch", "GripCapacity",
+           "GripConfig", "GripState"]
 
 #: Finger positions along the grip axis [m] (robot.kinematic_tree: −0.036 + 0.018·i).
 FINGER_X_M = (-0.036, -0.018, 0.0, 0.018, 0.036)
@@ -102,18 +116,22 @@ class GripCapacity:
                    per_finger * sum(abs(x) for x in FINGER_X_M))
 
     def utilisation(self, force_n: np.ndarray, torque_nm: np.ndarray,
-                    axis: np.ndarray) -> tuple[float, str]:
-        """Largest load / capacity ratio and which component it is."""
+                    axis: np.ndarray) -> dict[str, float]:
+        """Load / capacity ratio of each component (`SLIP_LOADS` and `RELEASE_LOADS`)."""
         fa = float(force_n @ axis)
         ta = float(torque_nm @ axis)
-        parts = {
-            "radial force": np.linalg.norm(force_n - fa * axis) / self.radial_n,
+        return {
+            "radial force": float(np.linalg.norm(force_n - fa * axis)) / self.radial_n,
             "force along the rail": abs(fa) / self.axial_n,
             "torque about the rail": abs(ta) / self.roll_nm,
-            "bending torque": np.linalg.norm(torque_nm - ta * axis) / self.bending_nm,
+            "bending torque": float(np.linalg.norm(torque_nm - ta * axis)) / self.bending_nm,
         }
-        name = max(parts, key=parts.get)
-        return float(parts[name]), name
+
+
+#: Loads a closed hand gives way to by slipping on its rail (still latched).
+SLIP_LOADS = ("force along the rail", "torque about the rail")
+#: Loads that pull the rail out of the fingers or pry them open: the grip lets go.
+RELEASE_LOADS = ("radial force", "bending torque")
 
 
 class GripState(Enum):
@@ -137,6 +155,12 @@ class GraspEvent:
     def __str__(self) -> str:
         where = f" rail {self.rail}" if self.rail else ""
         return f"{self.hand} hand {self.kind}{where} at t = {self.time_s:.2f} s: {self.reason}"
+
+
+def _conj(q: np.ndarray) -> np.ndarray:
+    out = np.zeros(4)
+    mujoco.mju_negQuat(out, q)
+    return out
 
 
 def _segment_closest(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -187,6 +211,7 @@ class GraspLatch:
         self.state = GripState.OPEN
         self.rail: str | None = None
         self._overload_s = 0.0
+        self.slip_m = self.slip_rad = 0.0
         self.peak_utilisation = 0.0
         self.last_utilisation = (0.0, "")
         self.data.eq_active[self.eq_id] = 0
@@ -239,8 +264,11 @@ class GraspLatch:
                 return self._release(time_s, "fingers commanded open", GripState.OPEN)
             force, torque = self.grip_load()
             axis = self._rail_axis(self.rail)
-            self.last_utilisation = self.capacity.utilisation(force, torque, axis)
-            u, what = self.last_utilisation
+            parts = self.capacity.utilisation(force, torque, axis)
+            self._slip(parts, axis)
+            what = max(RELEASE_LOADS, key=parts.get)
+            u = parts[what]
+            self.last_utilisation = (u, what)
             self.peak_utilisation = max(self.peak_utilisation, u)
             self._overload_s = self._overload_s + dt_s if u > 1.0 else 0.0
             if self._overload_s >= cfg.slip_persistence_s - 1e-12:
@@ -276,6 +304,34 @@ class GraspLatch:
                        f"{math.degrees(cfg.angle_tolerance_rad):.0f}°)")
         return GraspEvent(self.hand, "missed", time_s, rail,
                           "fingers closed on nothing: " + "; ".join(why), dist, ang)
+
+    def _slip(self, parts: dict[str, float], axis: np.ndarray) -> None:
+        """Move the weld's anchor about and along the rail where friction gives way
+        (module docstring): by the share ``1 − 1/utilisation`` of the hand's offset from
+        the anchor in that direction."""
+        u_along, u_about = parts["force along the rail"], parts["torque about the rail"]
+        if u_along <= 1.0 and u_about <= 1.0:
+            return
+        d, eq = self.data, self.model.eq_data[self.eq_id]
+        R_l, x_l = d.xmat[self.ladder_body].reshape(3, 3), d.xpos[self.ladder_body]
+        if u_along > 1.0:
+            anchor = R_l @ eq[0:3] + x_l
+            offset_m = float((d.site_xpos[self.palm_site] - anchor) @ axis)
+            shift_m = offset_m * (1.0 - 1.0 / u_along)
+            eq[0:3] += R_l.T @ (axis * shift_m)
+            self.slip_m += abs(shift_m)
+        if u_about > 1.0:
+            q_lad = d.xquat[self.ladder_body]
+            q_anchor, q_err, turn = np.zeros(4), np.zeros(4), np.zeros(4)
+            mujoco.mju_mulQuat(q_anchor, q_lad, _conj(eq[6:10]))
+            mujoco.mju_mulQuat(q_err, d.xquat[self.body_id], _conj(q_anchor))
+            rotvec = np.zeros(3)
+            mujoco.mju_quat2Vel(rotvec, q_err, 1.0)
+            turn_rad = float(rotvec @ axis) * (1.0 - 1.0 / u_about)
+            mujoco.mju_axisAngle2Quat(turn, axis, turn_rad)
+            mujoco.mju_mulQuat(q_anchor, turn.copy(), q_anchor.copy())
+            mujoco.mju_mulQuat(eq[6:10], _conj(q_anchor), q_lad)
+            self.slip_rad += abs(turn_rad)
 
     def _rail_axis(self, rail: str) -> np.ndarray:
         s0, s1, _ = self.rails[rail]

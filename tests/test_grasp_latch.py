@@ -5,6 +5,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+import mujoco
 import numpy as np
 import pytest
 
@@ -13,12 +14,13 @@ sys.path.insert(0, str(Path(__file__).parent / "fixtures"))
 from make_fixture import cached_reach_fixture  # noqa: E402
 
 from daemon.board_model import PlacementError  # noqa: E402
+from daemon.control_modes import RefMode  # noqa: E402
 from daemon.grasp_latch import GripCapacity, GripConfig  # noqa: E402
 from daemon.joint_control import JointController  # noqa: E402
 from daemon.pwm import default_drc_gains  # noqa: E402
 from execute.simulate import SimulationOptions, simulate  # noqa: E402
 from ladders.spec import LadderSpec  # noqa: E402
-from robot.joints import FINGER_JOINTS, JOINT_INDEX, NUM_JOINTS  # noqa: E402
+from robot.joints import ARM_JOINTS, FINGER_JOINTS, JOINT_INDEX, NUM_JOINTS  # noqa: E402
 from robot.plan_sidecar import read_sidecar, sidecar_path  # noqa: E402
 from robot.trajectory_file import read_trajectory  # noqa: E402
 
@@ -36,17 +38,22 @@ def latched_run(plan):
     return simulate(traj, sc, ladder, SimulationOptions(strategy="mixed", record_qpos=False))
 
 
-def _hold(run, ticks: int, ref: np.ndarray, extra=None) -> list:
-    """Keep stepping a finished run's board with the control law at ``ref``."""
+def _hold(run, ticks: int, ref: np.ndarray, extra=None, limp_arm: str | None = None) -> list:
+    """Keep stepping a finished run's board with the control law at ``ref``; the arm
+    ``limp_arm`` in PWM with its reference on its encoder (no stiffness)."""
     board = run.board
     ctl = JointController()
     gains = default_drc_gains()
     comply = np.zeros(NUM_JOINTS, dtype=bool)
+    mode = np.full(NUM_JOINTS, int(RefMode.FILTER), dtype=np.int8)
+    if limp_arm is not None:
+        arm = [JOINT_INDEX[n] for n in ARM_JOINTS[limp_arm]]
+        comply[arm], mode[arm] = True, RefMode.COMPLIANT
     events = []
     for k in range(ticks):
         if extra is not None:
             extra(k)
-        out = ctl.tick(ref, 0, comply, board.joint_pos(), board.joint_vel(), gains)
+        out = ctl.tick(ref, mode, comply, board.joint_pos(), board.joint_vel(), gains)
         board.apply(out)
         events += board.step()[1]
     return events
@@ -57,8 +64,9 @@ def test_capacity_from_finger_torque():
     assert cap.radial_n == pytest.approx(5 * 5.0 / 0.06)
     assert cap.axial_n == pytest.approx(2 * 0.4 * cap.radial_n)
     axis = np.array([0.0, 0.0, 1.0])
-    u, what = cap.utilisation(np.array([cap.radial_n * 1.5, 0, 0]), np.zeros(3), axis)
-    assert u == pytest.approx(1.5) and what == "radial force"
+    parts = cap.utilisation(np.array([cap.radial_n * 1.5, 0, 0]), np.zeros(3), axis)
+    assert parts["radial force"] == pytest.approx(1.5)
+    assert max(parts, key=parts.get) == "radial force"
 
 
 def test_latches_on_the_rail(latched_run):
@@ -107,3 +115,69 @@ def test_releases_over_load(plan):
     board.data.xfrc_applied[:] = 0.0
     rel = [g for g in events if g.kind == "released"]
     assert rel and rel[0].hand == "right" and "what the grip holds" in rel[0].reason
+
+
+
+def _offset_from_anchor(latch, axis) -> tuple[float, float]:
+    """The hand's turn about [rad] and slide along [m] the rail from the weld's anchor."""
+    d, eq = latch.data, latch.model.eq_data[latch.eq_id]
+    R_l = d.xmat[latch.ladder_body].reshape(3, 3)
+    anchor = R_l @ eq[0:3] + d.xpos[latch.ladder_body]
+    q_anchor, q_err, rotvec = np.zeros(4), np.zeros(4), np.zeros(3)
+    neg = np.zeros(4)
+    mujoco.mju_negQuat(neg, eq[6:10])
+    mujoco.mju_mulQuat(q_anchor, d.xquat[latch.ladder_body], neg)
+    mujoco.mju_negQuat(neg, q_anchor)
+    mujoco.mju_mulQuat(q_err, d.xquat[latch.body_id], neg)
+    mujoco.mju_quat2Vel(rotvec, q_err, 1.0)
+    return float(rotvec @ axis), float((d.site_xpos[latch.palm_site] - anchor) @ axis)
+
+
+def test_a_slipping_grip_moves_its_anchor_to_leave_the_capacity(latched_run):
+    """Twice the friction limit about and along the rail: the weld's anchor moves half
+    way to the hand in both directions (its spring then carries the capacity); within
+    the limit it stays."""
+    latch = latched_run.board.latches["right"]
+    axis = latch._rail_axis(latch.rail)
+    eq = latch.model.eq_data[latch.eq_id]
+    slipped_rad, slipped_m = latch.slip_rad, latch.slip_m
+    saved = eq.copy()
+    turn = np.zeros(4)
+    mujoco.mju_axisAngle2Quat(turn, axis, 0.02)  # the anchor 0.02 rad and 4 mm off
+    mujoco.mju_mulQuat(eq[6:10], saved[6:10].copy(), turn)
+    R_l = latch.data.xmat[latch.ladder_body].reshape(3, 3)
+    eq[0:3] -= R_l.T @ axis * 0.004
+    try:
+        before = _offset_from_anchor(latch, axis)
+        latch._slip({"force along the rail": 0.9, "torque about the rail": 0.9}, axis)
+        assert _offset_from_anchor(latch, axis) == pytest.approx(before)
+        latch._slip({"force along the rail": 2.0, "torque about the rail": 2.0}, axis)
+        after = _offset_from_anchor(latch, axis)
+        assert abs(before[0]) > 0.015 and abs(before[1]) > 0.003
+        assert after == pytest.approx((before[0] / 2, before[1] / 2), rel=1e-3)
+        assert latch.slip_rad - slipped_rad == pytest.approx(abs(before[0]) / 2, rel=1e-3)
+        assert latch.slip_m - slipped_m == pytest.approx(abs(before[1]) / 2, rel=1e-3)
+    finally:
+        eq[:] = saved
+
+
+
+def test_a_grip_turns_on_its_rail_and_holds(plan):
+    """Twice the friction limit about the rail, on a hand whose arm is limp: the closed
+    hand turns on the rail, the weld carries no more than the grip's friction, and the
+    hand stays latched."""
+    traj, sc, ladder = plan
+    run = simulate(traj, sc, ladder, SimulationOptions(strategy="mixed", record_qpos=False))
+    latch = run.board.latches["right"]
+    axis = latch._rail_axis(latch.rail)
+    run.board.data.xfrc_applied[latch.body_id, 3:6] = 2.0 * latch.capacity.roll_nm * axis
+    about_rail = []
+
+    def record(_k):
+        force, torque = latch.grip_load()
+        about_rail.append(latch.capacity.utilisation(force, torque, axis)["torque about the rail"])
+
+    events = _hold(run, 100, run.board.joint_pos(), record, limp_arm="right")
+    assert not events and latch.latched
+    assert latch.slip_rad > 0.0
+    assert max(about_rail) == pytest.approx(1.0, abs=0.05)
