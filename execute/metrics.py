@@ -14,8 +14,9 @@
   executor does not import); they are left out, so the figure is ``None`` when no tick
   qualifies.
 - **Hold slip**: the largest drift of a sole from where it stood at the start of a
-  segment that keeps that foot on a hold [m]; latched hands are welded and do not slip
-  (their loss is a verdict failure).
+  segment that keeps that foot on a hold [m]; per hand, how far in all it turned about
+  and slid along its rails while latched (`daemon.grasp_latch`: beyond the grip's
+  friction a closed hand slips on its rail; letting go is a verdict failure).
 - **Simulated seconds per rung**: simulated time / rungs climbed (the highest rung the
   plan puts a foot on, +1), ``None`` when no rung is climbed.
 - **Real-time factor**: simulated time / wall time of the loop.
@@ -46,6 +47,8 @@ class RunMetrics:
     peak_torque_joint: str
     min_com_margin_m: float | None
     max_foot_slip_m: float
+    hand_turn_on_rail_rad: dict[str, float]  # hand → total turn about its rails
+    hand_slide_on_rail_m: dict[str, float]  # hand → total slide along its rails
     simulated_s: float
     simulated_s_per_rung: float | None
     real_time_factor: float
@@ -143,7 +146,10 @@ def compute_metrics(run) -> RunMetrics:
     return RunMetrics(
         tracking_error_rad=by_arm, tracking_error_by_joint_rad=by_joint,
         peak_torque_ratio=peak, peak_torque_joint=peak_joint, min_com_margin_m=margin,
-        max_foot_slip_m=slip, simulated_s=sim_s,
+        max_foot_slip_m=slip,
+        hand_turn_on_rail_rad={h: latch.slip_rad for h, latch in run.board.latches.items()},
+        hand_slide_on_rail_m={h: latch.slip_m for h, latch in run.board.latches.items()},
+        simulated_s=sim_s,
         simulated_s_per_rung=sim_s / climbed if climbed else None,
         real_time_factor=float(run.real_time_factor) if math.isfinite(
             run.real_time_factor) else 0.0,

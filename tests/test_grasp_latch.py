@@ -18,6 +18,7 @@ from daemon.control_modes import RefMode  # noqa: E402
 from daemon.grasp_latch import GripCapacity, GripConfig  # noqa: E402
 from daemon.joint_control import JointController  # noqa: E402
 from daemon.pwm import default_drc_gains  # noqa: E402
+from execute.metrics import compute_metrics  # noqa: E402
 from execute.simulate import SimulationOptions, simulate  # noqa: E402
 from ladders.spec import LadderSpec  # noqa: E402
 from robot.joints import ARM_JOINTS, FINGER_JOINTS, JOINT_INDEX, NUM_JOINTS  # noqa: E402
@@ -180,4 +181,5 @@ def test_a_grip_turns_on_its_rail_and_holds(plan):
     events = _hold(run, 100, run.board.joint_pos(), record, limp_arm="right")
     assert not events and latch.latched
     assert latch.slip_rad > 0.0
+    assert compute_metrics(run).hand_turn_on_rail_rad["right"] == latch.slip_rad
     assert max(about_rail) == pytest.approx(1.0, abs=0.05)
