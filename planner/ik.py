@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from planner.contacts import Hold
-from planner.kinematics import WRIST_ALIGNMENT_MARGIN_RAD, HuboKinematics
+from planner.kinematics import HuboKinematics
 
 log = logging.getLogger(__name__)
 
@@ -157,44 +157,19 @@ def solve_ik(kin: HuboKinematics, q_seed: np.ndarray, support: tuple[Hold, ...],
     solver.add_regularization_task(config.regularization)
     it = 0
     pos_err = ang_err = np.inf
-    saved_limits = _bound_gripping_wrists(kin, q_seed, support)
-    try:
-        for it in range(1, config.max_iterations + 1):
-            robot.update_kinematics()
-            try:
-                solver.solve(True)
-            except RuntimeError as exc:  # placo reports infeasible QPs as bare RuntimeErrors
-                log.debug("IK QP failed at iteration %d: %s", it, exc)
-                break
-            robot.update_kinematics()
-            pos_err, ang_err, ok = _errors(kin, support, moving, config)
-            if ok and it > 2:
-                break
-    finally:
-        for name, limits in saved_limits:
-            robot.set_joint_limits(name, *limits)
+    for it in range(1, config.max_iterations + 1):
+        robot.update_kinematics()
+        try:
+            solver.solve(True)
+        except RuntimeError as exc:  # placo reports infeasible QPs as bare RuntimeErrors
+            log.debug("IK QP failed at iteration %d: %s", it, exc)
+            break
+        robot.update_kinematics()
+        pos_err, ang_err, ok = _errors(kin, support, moving, config)
+        if ok and it > 2:
+            break
     converged = bool(np.isfinite(pos_err)) and _errors(kin, support, moving, config)[2]
     return IKResult(kin.q, converged, it, float(pos_err), float(ang_err))
-
-
-def _bound_gripping_wrists(kin: HuboKinematics, q_seed: np.ndarray,
-                           support: tuple[Hold, ...]) -> list[tuple[str, np.ndarray]]:
-    """Keep each gripping hand's wrist pitch on its seed's side of 0, at least
-    `WRIST_ALIGNMENT_MARGIN_RAD` from it (or no nearer than the seed, if the seed is
-    nearer), by narrowing the joint's limits for one solve. Returns the limits to restore.
-    """
-    saved = []
-    for hold in support:
-        name = kin.wrist_pitch_joint(hold.frame) if hold.is_hand else None
-        pitch_rad = q_seed[kin.q_index[name]] if name else 0.0
-        if pitch_rad == 0.0:
-            continue
-        lo, hi = limits = kin.wrapper.get_joint_limits(name)
-        clear_rad = min(WRIST_ALIGNMENT_MARGIN_RAD, abs(pitch_rad))
-        kin.wrapper.set_joint_limits(name, *((min(clear_rad, hi), hi) if pitch_rad > 0
-                                             else (lo, max(-clear_rad, lo))))
-        saved.append((name, limits))
-    return saved
 
 
 def _errors(kin: HuboKinematics, support, moving, config: IKConfig) -> tuple[float, float, bool]:

@@ -19,15 +19,6 @@ from robot.urdf import robot_urdf
 #: planned torques, then decides what its hand carries.
 ARM_LIMIT_MARGIN_RAD = 0.05
 
-#: A hand holding a rail keeps its wrist pitch at least this far from 0 [rad]. At 0 the
-#: wrist yaw and roll axes line up along the forearm: the hand cannot turn about one axis
-#: at all, and near it a small turn of the hand takes large, opposite yaw and roll
-#: motions, 1/sin|pitch| times the turn. A DRC plan crossing it spun a gripping wrist's
-#: yaw and roll 1.8 rad each while the body rose; in MuJoCo the compliant wrist, moved by
-#: the body's centimetre of sag, ran onto its yaw stop and bent the grip open. At 0.3 rad
-#: (17°) the amplification is at most 3.4.
-WRIST_ALIGNMENT_MARGIN_RAD = 0.3
-
 
 @dataclass
 class HuboKinematics:
@@ -57,12 +48,6 @@ class HuboKinematics:
         q_index = {model.names[j]: model.joints[j].idx_q for j in range(2, model.njoints)}
         index = np.array([q_index.get(name, -1) for name in JOINT_NAMES])
         return cls(params, wrapper, model, model.createData(), index, q_index)
-
-    def wrist_pitch_joint(self, hand_frame: str) -> str | None:
-        """The wrist pitch that separates the yaw and roll axes of the hand whose frame is
-        ``hand_frame`` (``L_palm``/``R_palm``); None on a wrist without roll (Hubo2+)."""
-        side = hand_frame[0]
-        return f"{side}WP" if f"{side}WR" in self.q_index else None
 
     @property
     def q(self) -> np.ndarray:

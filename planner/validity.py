@@ -20,7 +20,7 @@ from planner.arm_capacity import (
 )
 from planner.collision import CollisionModel
 from planner.contacts import Stance
-from planner.kinematics import WRIST_ALIGNMENT_MARGIN_RAD, HuboKinematics
+from planner.kinematics import HuboKinematics
 from planner.stability import (
     SupportRegion,
     TorqueCheck,
@@ -99,11 +99,6 @@ class FeasibilityChecker:
         """
         if not self.within_limits(q):
             return Verdict(False, "joint limits", np.nan, np.nan)
-        for hold in stance.holds:
-            name = self.kin.wrist_pitch_joint(hold.frame) if hold.is_hand else None
-            if name and abs(q[self.kin.q_index[name]]) < WRIST_ALIGNMENT_MARGIN_RAD - LIMIT_TOL_RAD:
-                return Verdict(False, f"{name} {q[self.kin.q_index[name]]:+.2f} rad: wrist yaw "
-                               f"and roll nearly aligned", np.nan, np.nan)
         self.collision.allow(contacts)
         if self.collision.in_collision(q):
             pairs = self.collision.colliding_pairs(q)

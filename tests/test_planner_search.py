@@ -9,7 +9,6 @@ from ladders.loader import load_ladder
 from planner.contacts import Hold, Stance
 from planner.ik import solve_ik
 from planner.interpolation import InterpolationError, contact_space_interpolate
-from planner.kinematics import WRIST_ALIGNMENT_MARGIN_RAD
 from planner.search import ClimbPlanner, PlannerConfig, PlanningFailed, StepStats
 from primitives.library import climb_sequence
 
@@ -155,22 +154,17 @@ def test_a_stage_solved_on_one_rung_is_the_first_guess_on_the_next(planner, stan
 
 def test_stepping_onto_rung_0_with_compliant_arms_is_found():
     """The hardest step of the DRC mount: the right foot leaves the floor with the left on
-    rung 0 (0.305 m up) and PWM-compliant arms; the torque descent must find it. The body
-    rises past the hands there: the gripping wrists stay clear of their yaw–roll
-    alignment all along the way."""
+    rung 0 (0.305 m up) and PWM-compliant arms; the torque descent must find it."""
     p = ClimbPlanner(load_ladder("drc"), seed=1)
     assert p.config.arm_strategy == "mixed"
     q, stance = p.start_configuration()
     steps = climb_sequence(0)
-    segments = []
     for step in steps[:2]:
-        done, q, stance = p.try_step(step, q, stance, 0.0, StepStats("x"))
-        segments += done
+        _, q, stance = p.try_step(step, q, stance, 0.0, StepStats("x"))
     for attempt in range(10):
         try:
-            done, q_end, new_stance = p.try_step(steps[2], q, stance, 0.0, StepStats("x"),
-                                                 attempt)
-            segments += done
+            _, q_end, new_stance = p.try_step(steps[2], q, stance, 0.0, StepStats("x"),
+                                              attempt)
             break
         except Exception:  # noqa: BLE001 - a failed sample; the search tries another
             continue
@@ -179,11 +173,6 @@ def test_stepping_onto_rung_0_with_compliant_arms_is_found():
     verdict = p.checker.check(q_end, new_stance, {h.limb: h.target for h in new_stance.holds})
     assert verdict.ok and verdict.torque_ratio <= 1.0
     assert {h.target for h in new_stance.holds if not h.is_hand} == {"rung_0"}
-    gripping = [(p.kin.q_index[p.kin.wrist_pitch_joint(h.frame)], q_k) for seg in segments
-                for h in seg.holds if h.is_hand and h.limb not in seg.moving_limbs
-                for q_k in seg.configs]
-    assert len(gripping) > 1000
-    assert min(abs(q_k[i]) for i, q_k in gripping) >= WRIST_ALIGNMENT_MARGIN_RAD - 1e-6
 
 
 def test_stepping_off_the_floor_seeds_the_pelvis_as_high_as_the_floor_leg_reaches(
