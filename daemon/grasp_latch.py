@@ -128,7 +128,8 @@ class GripCapacity:
         }
 
 
-#: Loads a closed hand gives way to by slipping on its rail (still latched).
+#: Loads a closed hand gives way to by slipping on its rail (still latched), in the order
+#: `GraspLatch._slip` reads them: along, about.
 SLIP_LOADS = ("force along the rail", "torque about the rail")
 #: Loads that pull the rail out of the fingers or pry them open: the grip lets go.
 RELEASE_LOADS = ("radial force", "bending torque")
@@ -309,8 +310,8 @@ class GraspLatch:
         """Move the weld's anchor about and along the rail where friction gives way
         (module docstring): by the share ``1 − 1/utilisation`` of the hand's offset from
         the anchor in that direction."""
-        u_along, u_about = parts["force along the rail"], parts["torque about the rail"]
-        if u_along <= 1.0 and u_about <= 1.0:
+        u_along, u_about = (parts[load] for load in SLIP_LOADS)
+        if max(u_along, u_about) <= 1.0:
             return
         d, eq = self.data, self.model.eq_data[self.eq_id]
         R_l, x_l = d.xmat[self.ladder_body].reshape(3, 3), d.xpos[self.ladder_body]
@@ -330,8 +331,15 @@ class GraspLatch:
             turn_rad = float(rotvec @ axis) * (1.0 - 1.0 / u_about)
             mujoco.mju_axisAngle2Quat(turn, axis, turn_rad)
             mujoco.mju_mulQuat(q_anchor, turn.copy(), q_anchor.copy())
-            mujoco.mju_mulQuat(eq[6:10], _conj(q_anchor), q_lad)
+            eq[6:10] = self._relpose(q_anchor)
             self.slip_rad += abs(turn_rad)
+
+    def _relpose(self, q_hand: np.ndarray) -> np.ndarray:
+        """The weld's relpose quaternion that holds the hand at orientation ``q_hand``:
+        ``q_ladder = q_hand · relpose``."""
+        out = np.zeros(4)
+        mujoco.mju_mulQuat(out, _conj(q_hand), self.data.xquat[self.ladder_body])
+        return out
 
     def _rail_axis(self, rail: str) -> np.ndarray:
         s0, s1, _ = self.rails[rail]
@@ -348,11 +356,7 @@ class GraspLatch:
         eq = m.eq_data[self.eq_id]
         eq[0:3] = R_l.T @ (p - d.xpos[lad])  # anchor in the ladder (body2) frame
         eq[3:6] = R_h.T @ (p - d.xpos[h])  # the same point in the hand (body1) frame
-        q = np.zeros(4)
-        neg = np.zeros(4)
-        mujoco.mju_negQuat(neg, d.xquat[h])
-        mujoco.mju_mulQuat(q, neg, d.xquat[lad])  # relpose: q_ladder = q_hand · relpose
-        eq[6:10] = q
+        eq[6:10] = self._relpose(d.xquat[h])
         eq[10] = 1.0  # torquescale
         d.eq_active[self.eq_id] = 1
         self.state = GripState.LATCHED
