@@ -29,6 +29,9 @@ class IKConfig:
 
     max_iterations: int = 80
     step_dt_s: float = 0.02
+    # A hard hold further off than one bounded step corrects makes the QP infeasible: the
+    # bound, not the hold, then gives way, doubling up to this step.
+    max_step_dt_s: float = 0.32
     position_tol_m: float = 1e-4  # supporting holds (hard tasks)
     moving_tol_m: float = 1e-3  # a moving limb reaching its new hold
     waypoint_tol_m: float = 5e-3  # a moving limb in the air, between way-points
@@ -123,8 +126,8 @@ def solve_ik(kin: HuboKinematics, q_seed: np.ndarray, support: tuple[Hold, ...],
     solver.mask_fbase(False)
     solver.enable_joint_limits(True)
     # Bounding each step by the joints' speed limits × dt keeps the linearised hard tasks
-    # valid; unbounded steps from a far soft target made the QP diverge.
-    solver.dt = config.step_dt_s
+    # valid; unbounded steps from a far soft target made the QP diverge. The bound is
+    # set per step (`_solve_widening_step`).
     solver.enable_velocity_limits(True)
     for name in robot.joint_names():
         if name.startswith(FIXED_JOINT_PREFIXES):
@@ -159,10 +162,7 @@ def solve_ik(kin: HuboKinematics, q_seed: np.ndarray, support: tuple[Hold, ...],
     pos_err = ang_err = np.inf
     for it in range(1, config.max_iterations + 1):
         robot.update_kinematics()
-        try:
-            solver.solve(True)
-        except RuntimeError as exc:  # placo reports infeasible QPs as bare RuntimeErrors
-            log.debug("IK QP failed at iteration %d: %s", it, exc)
+        if not _solve_widening_step(solver, config, it):
             break
         robot.update_kinematics()
         pos_err, ang_err, ok = _errors(kin, support, moving, config)
@@ -170,6 +170,23 @@ def solve_ik(kin: HuboKinematics, q_seed: np.ndarray, support: tuple[Hold, ...],
             break
     converged = bool(np.isfinite(pos_err)) and _errors(kin, support, moving, config)[2]
     return IKResult(kin.q, converged, it, float(pos_err), float(ang_err))
+
+
+def _solve_widening_step(solver, config: IKConfig, iteration: int) -> bool:
+    """One QP step; while it is infeasible, the step bound doubles up to
+    ``config.max_step_dt_s`` (for this step only). False when even that bound leaves it
+    infeasible."""
+    solver.dt = config.step_dt_s
+    while True:
+        try:
+            solver.solve(True)
+            return True
+        except RuntimeError as exc:  # placo reports infeasible QPs as bare RuntimeErrors
+            if solver.dt * 2 > config.max_step_dt_s + 1e-12:
+                log.debug("IK QP failed at iteration %d (step %.2f s): %s", iteration,
+                          solver.dt, exc)
+                return False
+            solver.dt *= 2
 
 
 def _errors(kin: HuboKinematics, support, moving, config: IKConfig) -> tuple[float, float, bool]:

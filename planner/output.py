@@ -8,7 +8,8 @@ and version.
 
 PWM (compliant) mode is scheduled for an arm while its hand holds a rail or its palm is
 within `PWM_RAIL_DISTANCE_M` of its rail's axis (closing, opening, the first and last
-centimetres of a reach); position mode while the hand moves through the air.
+centimetres of a reach); position mode while the hand moves through the air, and
+throughout a plan made for rigid arms (``arm_strategy`` ``position``).
 """
 
 from __future__ import annotations
@@ -370,7 +371,9 @@ def write_plan(result: SearchResult, planner: ClimbPlanner, out_traj: str | os.P
     arm_modes = {}
     for side in ARMS:
         holding = hand_holding_lines(segments, timed.line_count, side)
-        arm_modes[side] = arm_mode_runs(holding | (distances[side] <= PWM_RAIL_DISTANCE_M))
+        pwm = holding | (distances[side] <= PWM_RAIL_DISTANCE_M)
+        # A plan for rigid arms loads them beyond what a compliant arm gives.
+        arm_modes[side] = arm_mode_runs(pwm & (planner.config.arm_strategy != "position"))
     feedforward = arm_feedforward(result, timed, after, planner.checker)
     metrics = _metrics(result, planner, timed, segments, clearance_every)
     metrics["palm_rail_pwm_distance_m"] = PWM_RAIL_DISTANCE_M

@@ -108,21 +108,25 @@ def test_palm_distances_match_the_rail_geometry(plan):
     assert d["left"][0] > PWM_RAIL_DISTANCE_M  # standing on the floor, hands down
 
 
-def test_mode_schedule_from_palm_distance_and_grasps(plan, tmp_path, monkeypatch):
-    planner, result, q0 = plan
-    # The left palm closes in on its rail over the plan; the right one stays away.
+def _closing_on_the_rails(result, monkeypatch) -> SearchResult:
+    """The left palm closes in on its rail over the plan and the right hand holds its
+    rail in the grasp segment."""
     def fake(configs, kin, geom):
         n = len(configs)
         return {"left": np.linspace(0.10, 0.0, n), "right": np.full(n, 0.2)}
 
     monkeypatch.setattr(output, "palm_rail_distances", fake)
-    # The grasp segment holds the right rail: PWM there whatever the distance.
     grasp = result.segments[1]
     T = np.eye(4)
     rail = Hold("right_hand", "rail_right", T, np.zeros((2, 3)), np.tile([0, 0, 1.0], (2, 1)))
     segments = list(result.segments)
     segments[1] = dataclasses.replace(grasp, holds=grasp.holds + (rail,))
-    res = SearchResult(segments, result.final_stance, result.step_stats, result.total_s)
+    return SearchResult(segments, result.final_stance, result.step_stats, result.total_s)
+
+
+def test_mode_schedule_from_palm_distance_and_grasps(plan, tmp_path, monkeypatch):
+    planner, result, q0 = plan
+    res = _closing_on_the_rails(result, monkeypatch)
     out = write_plan(res, planner, tmp_path / "m.traj", 200.0, q_start=q0, clearance_every=0)
     sc = read_sidecar(out.sidecar_path)
     n = sc.line_count
@@ -134,6 +138,18 @@ def test_mode_schedule_from_palm_distance_and_grasps(plan, tmp_path, monkeypatch
                                      (g.first_line, g.last_line, "pwm"),
                                      (g.last_line + 1, n, "position")]
     assert sc.metrics["min_clearance_m"] is None
+
+
+def test_a_plan_for_rigid_arms_keeps_them_in_position_mode(plan, tmp_path, monkeypatch):
+    """Its holding torques are beyond what a compliant arm gives."""
+    planner, result, q0 = plan
+    res = _closing_on_the_rails(result, monkeypatch)
+    monkeypatch.setattr(planner, "config", dataclasses.replace(planner.config,
+                                                               arm_strategy="position"))
+    out = write_plan(res, planner, tmp_path / "r.traj", 200.0, q_start=q0, clearance_every=0)
+    sc = read_sidecar(out.sidecar_path)
+    assert sc.metrics["arm_strategy"] == "position"
+    assert sc.arm_modes == {arm: [(1, sc.line_count, "position")] for arm in ("left", "right")}
 
 
 def test_same_input_same_bytes(plan, written, tmp_path):

@@ -7,7 +7,7 @@ import pytest
 
 from ladders.loader import load_ladder
 from planner.contacts import Hold, Stance
-from planner.ik import solve_ik
+from planner.ik import IKConfig, solve_ik
 from planner.interpolation import InterpolationError, contact_space_interpolate
 from planner.search import ClimbPlanner, PlannerConfig, PlanningFailed, StepStats
 from primitives.library import climb_sequence
@@ -69,6 +69,21 @@ def test_a_hand_target_at_the_hand_s_own_pose_is_solved(planner, standing):
     assert r.converged and r.position_error_m < 1e-4
 
 
+
+def test_a_hard_hold_beyond_one_bounded_step_widens_the_step(planner, standing):
+    """The midpoint of a long move (a lift-off far from the stance it leaves) can be
+    centimetres off its holds; one speed-bounded step cannot meet a hard hold that far
+    off, and the QP was infeasible: every compliant-arm mount sample of a random 60°
+    ladder failed so. The step bound now widens for that step."""
+    q, stance = standing
+    off = q.copy()
+    off[planner.kin.q_index["LKN"]] += 0.8  # the left foot far off its hold
+    base = IKConfig()
+    fixed = solve_ik(planner.kin, off, stance.holds,
+                     config=replace(base, max_step_dt_s=base.step_dt_s))
+    widened = solve_ik(planner.kin, off, stance.holds, config=base)
+    assert not fixed.converged and fixed.iterations == 1
+    assert widened.converged and widened.position_error_m < base.position_tol_m
 @pytest.mark.parametrize("resolution", [0.01, 0.04])
 def test_interpolation_meets_the_resolution(planner, standing, resolution):
     q, stance = standing
