@@ -4,7 +4,10 @@
   both hands up, both feet up, straighten; the mount counts as rung 0);
 - a whole DRC ladder ≤ 60 s on one core (seed 1);
 - planner success over seeds ≥ 95 % (quick: seeds 1–3 on ``drc``; ``full=True`` or
-  ``HUBO_BENCH_FULL=1``: seeds 1–20 on every bundled ladder).
+  ``HUBO_BENCH_FULL=1``: seeds 1–20 on every bundled ladder);
+- full only: at least 20 of the 40 random ladders of `RANDOM_LADDERS` (slope 55–75°,
+  spacing 0.25–0.35 m, rails 0.6–1.0 m apart) planned, seed 1, with compliant gripping
+  arms (the default) and with rigid ones, each capped at `TIME_LIMIT_S`.
 
 Each plan is capped at `TIME_LIMIT_S` (quick) or `FULL_TIME_LIMIT_S` (full); a capped
 run counts as a failure. Run with ``.venv/bin/python bench/bench_planner.py``.
@@ -12,14 +15,18 @@ run counts as a failure. Run with ``.venv/bin/python bench/bench_planner.py``.
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import os
 import statistics
 import time
+from pathlib import Path
 
 TARGET_PER_RUNG_S = 5.0
 TARGET_LADDER_S = 60.0
 TARGET_SUCCESS = 0.95
+TARGET_RANDOM_LADDERS = 20
+RANDOM_LADDERS = Path(__file__).with_name("random_ladders.yaml")
 #: Per-plan time cap [s]: twice the whole-ladder target, so a slow success still counts.
 TIME_LIMIT_S = 120.0
 FULL_TIME_LIMIT_S = 600.0
@@ -29,15 +36,19 @@ FULL_SEEDS = tuple(range(1, 21))
 log = logging.getLogger(__name__)
 
 
-def _plan_once(ladder: str, seed: int, time_limit_s: float) -> dict:
-    """One full-ladder plan: success, wall time [s], search seconds per rung."""
+def _plan_once(ladder, seed: int, time_limit_s: float, arm_strategy: str | None = None) -> dict:
+    """One full-ladder plan of a bundled ladder's name or a `LadderSpec`: success, wall
+    time [s], search seconds per rung. ``arm_strategy`` None: the planner's default."""
     from ladders.loader import load_ladder
     from planner.search import ClimbPlanner, PlannerConfig, PlanningFailed
     from robot.errors import HuboLadderError
 
     t0 = time.perf_counter()
-    planner = ClimbPlanner(load_ladder(ladder), config=PlannerConfig(time_limit_s=time_limit_s),
-                           seed=seed)
+    spec = load_ladder(ladder) if isinstance(ladder, str) else ladder
+    config = PlannerConfig(time_limit_s=time_limit_s)
+    if arm_strategy is not None:
+        config = dataclasses.replace(config, arm_strategy=arm_strategy)
+    planner = ClimbPlanner(spec, config=config, seed=seed)
     try:
         result = planner.plan()
     except PlanningFailed as exc:
@@ -92,6 +103,28 @@ def run(full: bool | None = None) -> list[dict]:
                     round(rate, 3), "unit": "fraction", "target": f">= {TARGET_SUCCESS:g}",
                     "ok": rate >= TARGET_SUCCESS,
                     **({"note": first_failure[:200]} if first_failure else {})})
+    if full:
+        out += _random_ladders()
+    return out
+
+
+def _random_ladders() -> list[dict]:
+    """How many of the random ladders plan, per arm strategy."""
+    from execute.batch_sweep import load_sweep
+    from planner.arm_capacity import ARM_STRATEGIES
+
+    cells = load_sweep(RANDOM_LADDERS)
+    out = []
+    for strategy in ARM_STRATEGIES:
+        runs = {c.name: _plan_once(c.spec, 1, TIME_LIMIT_S, strategy) for c in cells}
+        for name, r in runs.items():
+            log.info("%s (%s arms): %s in %.1f s %s", name, strategy,
+                     "ok" if r["ok"] else "FAILED", r["wall_s"], r["why"])
+        planned = sum(r["ok"] for r in runs.values())
+        out.append({"name": f"planner_random_ladders_planned_{strategy}_arms",
+                    "value": f"{planned}/{len(cells)}", "unit": "ladders",
+                    "target": f">= {TARGET_RANDOM_LADDERS}",
+                    "ok": planned >= TARGET_RANDOM_LADDERS})
     return out
 
 

@@ -138,6 +138,18 @@ def test_random_sweep_is_seeded():
     assert [x.params for x in c] != [x.params for x in a]
 
 
+def test_the_benchmark_s_random_ladders_span_the_issue_s_ranges():
+    from execute.batch_sweep import load_sweep
+
+    cells = load_sweep(Path(__file__).parents[1] / "bench" / "random_ladders.yaml")
+    assert len(cells) == 40
+    for lo, hi, values in ((55, 75, [c.spec.slope_deg for c in cells]),
+                           (0.25, 0.35, [c.spec.rung_spacing_m for c in cells]),
+                           (0.6, 1.0, [c.spec.rail_spacing_m for c in cells])):
+        assert lo <= min(values) and max(values) <= hi
+        assert max(values) - min(values) > 0.8 * (hi - lo)  # spread, not one corner
+
+
 @pytest.mark.parametrize("text,words", [
     (GRID.replace("slope_deg: [55, 60, 65]", "slope_deg: [55, 95]"),
      ["g.yaml:4:", "parameters.slope_deg", "[30, 90] deg"]),
