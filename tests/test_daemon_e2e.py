@@ -185,6 +185,20 @@ def test_sim_daemon_plays_the_fixture_with_automatic_modes(plan, tmp_path):
     assert np.abs(rec["pos"][-1, legs]).max() < 0.05
 
 
+#: The last cycles of a run [ticks] (2 s at 200 Hz) in which every board must answer.
+NO_REPLY_WINDOW = 400
+
+
+def _longest_run(flags: np.ndarray) -> int:
+    """Longest run of True down the rows of ``flags`` (cycles × joints), any column."""
+    longest = 0
+    run = np.zeros(flags.shape[1], dtype=int)
+    for row in flags:
+        run = np.where(row, run + 1, 0)
+        longest = max(longest, int(run.max()))
+    return longest
+
+
 def test_can_daemon_plays_the_fixture_over_virtual_buses(plan, tmp_path):
     tag = f"{os.getpid()}"
     d = Daemon(tmp_path, "can", "--backend", "can", "--can-interface", "virtual",
@@ -202,7 +216,13 @@ def test_can_daemon_plays_the_fixture_over_virtual_buses(plan, tmp_path):
     _check_mode_switches(rec, plan)
     sc = read_sidecar(sidecar_path(plan))
     last = read_trajectory(plan, sc.rate_hz)[-1]
-    assert not np.any(rec["status"][-1] & int(StatusFlag.NO_REPLY))
+    # Every board keeps answering. The emulator's threads share the GIL with the loop, so
+    # a reply now and then lands after the tick has read the bus (NO_REPLY for that
+    # cycle, as with a late board on a real bus: 3–7 % of a joint's cycles here, never
+    # more than 2 in a row); a silent board misses every one.
+    missed = (rec["status"][-NO_REPLY_WINDOW:] & int(StatusFlag.NO_REPLY)) != 0
+    assert missed.mean(axis=0).max() < 0.2
+    assert _longest_run(missed) <= 10
     rigid = ~rec["comply"][-1].astype(bool)
     # encoders decoded from the emulator's replies follow the encoded references
     assert np.abs(rec["pos"][-1, rigid] - last[rigid]).max() < 0.02
