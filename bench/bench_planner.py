@@ -15,12 +15,13 @@ run counts as a failure. Run with ``.venv/bin/python bench/bench_planner.py``.
 
 from __future__ import annotations
 
-import dataclasses
 import logging
 import os
 import statistics
 import time
 from pathlib import Path
+
+from planner.arm_capacity import DEFAULT_ARM_STRATEGY
 
 TARGET_PER_RUNG_S = 5.0
 TARGET_LADDER_S = 60.0
@@ -36,31 +37,31 @@ FULL_SEEDS = tuple(range(1, 21))
 log = logging.getLogger(__name__)
 
 
-def _plan_once(ladder, seed: int, time_limit_s: float, arm_strategy: str | None = None) -> dict:
-    """One full-ladder plan of a bundled ladder's name or a `LadderSpec`: success, wall
-    time [s], search seconds per rung. ``arm_strategy`` None: the planner's default."""
+def _plan_once(ladder, seed: int, time_limit_s: float,
+               arm_strategy: str = DEFAULT_ARM_STRATEGY) -> dict:
+    """One full-ladder plan of a bundled ladder's name or a `LadderSpec`, logged: success,
+    wall time [s], search seconds per rung."""
     from ladders.loader import load_ladder
     from planner.search import ClimbPlanner, PlannerConfig, PlanningFailed
     from robot.errors import HuboLadderError
 
     t0 = time.perf_counter()
     spec = load_ladder(ladder) if isinstance(ladder, str) else ladder
-    config = PlannerConfig(time_limit_s=time_limit_s)
-    if arm_strategy is not None:
-        config = dataclasses.replace(config, arm_strategy=arm_strategy)
-    planner = ClimbPlanner(spec, config=config, seed=seed)
+    planner = ClimbPlanner(spec, config=PlannerConfig(time_limit_s=time_limit_s,
+                                                      arm_strategy=arm_strategy), seed=seed)
     try:
         result = planner.plan()
-    except PlanningFailed as exc:
-        return {"ok": False, "wall_s": time.perf_counter() - t0,
-                "why": f"{exc.step.label}: {exc.reason}", "per_rung_s": {}}
-    except HuboLadderError as exc:
-        return {"ok": False, "wall_s": time.perf_counter() - t0, "why": str(exc),
-                "per_rung_s": {}}
+    except (PlanningFailed, HuboLadderError) as exc:
+        why = f"{exc.step.label}: {exc.reason}" if isinstance(exc, PlanningFailed) else str(exc)
+        log.info("%s seed %d (%s arms): FAILED in %.1f s %s", spec.name, seed, arm_strategy,
+                 time.perf_counter() - t0, why)
+        return {"ok": False, "wall_s": time.perf_counter() - t0, "why": why, "per_rung_s": {}}
     per_rung: dict[int, float] = {}
     for st in result.step_stats:
         rung = int(st.label.rsplit("rung", 1)[1])
         per_rung[rung] = per_rung.get(rung, 0.0) + st.seconds
+    log.info("%s seed %d (%s arms): ok in %.1f s", spec.name, seed, arm_strategy,
+             time.perf_counter() - t0)
     return {"ok": True, "wall_s": time.perf_counter() - t0, "why": "",
             "per_rung_s": per_rung, "search_s": result.total_s}
 
@@ -79,9 +80,6 @@ def run(full: bool | None = None) -> list[dict]:
     limit = FULL_TIME_LIMIT_S if full else TIME_LIMIT_S
     runs = {(ladder, seed): _plan_once(ladder, seed, limit)
             for ladder, seeds in plan.items() for seed in seeds}
-    for (ladder, seed), r in runs.items():
-        log.info("%s seed %d: %s in %.1f s %s", ladder, seed, "ok" if r["ok"] else "FAILED",
-                 r["wall_s"], r["why"])
     mode = "full" if full else "quick"
     out = []
     per_rung = [s for r in runs.values() for s in r["per_rung_s"].values()]
@@ -116,11 +114,7 @@ def _random_ladders() -> list[dict]:
     cells = load_sweep(RANDOM_LADDERS)
     out = []
     for strategy in ARM_STRATEGIES:
-        runs = {c.name: _plan_once(c.spec, 1, TIME_LIMIT_S, strategy) for c in cells}
-        for name, r in runs.items():
-            log.info("%s (%s arms): %s in %.1f s %s", name, strategy,
-                     "ok" if r["ok"] else "FAILED", r["wall_s"], r["why"])
-        planned = sum(r["ok"] for r in runs.values())
+        planned = sum(_plan_once(c.spec, 1, TIME_LIMIT_S, strategy)["ok"] for c in cells)
         out.append({"name": f"planner_random_ladders_planned_{strategy}_arms",
                     "value": f"{planned}/{len(cells)}", "unit": "ladders",
                     "target": f">= {TARGET_RANDOM_LADDERS}",

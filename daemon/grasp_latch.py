@@ -330,7 +330,7 @@ class GraspLatch:
             mujoco.mju_quat2Vel(rotvec, q_err, 1.0)
             turn_rad = float(rotvec @ axis) * (1.0 - 1.0 / u_about)
             mujoco.mju_axisAngle2Quat(turn, axis, turn_rad)
-            mujoco.mju_mulQuat(q_anchor, turn.copy(), q_anchor.copy())
+            mujoco.mju_mulQuat(q_anchor, turn, q_anchor.copy())
             eq[6:10] = self._relpose(q_anchor)
             self.slip_rad += abs(turn_rad)
 

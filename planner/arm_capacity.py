@@ -28,7 +28,8 @@ from robot.motors import DEFAULT_BATTERY_V, motor_table
 from robot.pwm_gains import safe_default_gain_table
 
 __all__ = ["ARM_STRATEGIES", "BACK_EMF_SHARE", "DEFAULT_ARM_STRATEGY",
-           "compliant_speed_rad_s", "compliant_torque_nm", "gripping_sides",
+           "arms_comply_while_gripping", "compliant_speed_rad_s", "compliant_torque_nm",
+           "gripping_sides",
            "gripping_torque_limits", "gripping_velocity_limits"]
 
 ARM_STRATEGIES = ("mixed", "position")
@@ -37,6 +38,17 @@ DEFAULT_ARM_STRATEGY = "mixed"
 #: on a rail is moved by the body at a speed its motor must follow, and the duty that
 #: overcomes the back-EMF is duty the arm's load cannot have.
 BACK_EMF_SHARE = 0.25
+
+
+def arms_comply_while_gripping(strategy: str) -> bool:
+    """Whether ``strategy`` puts an arm whose hand holds a rail in PWM compliance.
+
+    Raises:
+        ValueError: an unknown strategy.
+    """
+    if strategy not in ARM_STRATEGIES:
+        raise ValueError(f"unknown arm strategy {strategy!r}; use one of {ARM_STRATEGIES}")
+    return strategy != "position"
 
 
 @lru_cache(maxsize=16)
@@ -64,9 +76,7 @@ def gripping_velocity_limits(nominal_rad_s: np.ndarray, sides: Iterable[str],
     """Velocity limits (40,) [rad/s] while the arms of ``sides`` hold rails and
     ``strategy`` drives them: the nominal ones, the compliant arms' joints capped at
     `compliant_speed_rad_s`; None when nothing is capped."""
-    if strategy not in ARM_STRATEGIES:
-        raise ValueError(f"unknown arm strategy {strategy!r}; use one of {ARM_STRATEGIES}")
-    if strategy == "position" or not sides:
+    if not arms_comply_while_gripping(strategy) or not sides:
         return None
     limits = np.array(nominal_rad_s, dtype=float)
     speed = compliant_speed_rad_s(battery_v)
@@ -88,10 +98,8 @@ def gripping_torque_limits(torque_max_nm: Mapping[str, float], sides: Iterable[s
                            battery_v: float = DEFAULT_BATTERY_V) -> dict[str, float]:
     """Torque limits by joint [N·m] with the arms of ``sides`` ("left"/"right") driven as
     ``strategy`` drives a gripping arm."""
-    if strategy not in ARM_STRATEGIES:
-        raise ValueError(f"unknown arm strategy {strategy!r}; use one of {ARM_STRATEGIES}")
     limits = dict(torque_max_nm)
-    if strategy == "position":
+    if not arms_comply_while_gripping(strategy):
         return limits
     compliant = compliant_torque_nm(battery_v)
     for side in sides:

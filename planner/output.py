@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from planner.arm_capacity import DEFAULT_ARM_STRATEGY
+from planner.arm_capacity import DEFAULT_ARM_STRATEGY, arms_comply_while_gripping
 from robot.joints import ARM_JOINTS
 from robot.plan_sidecar import (
     ArmFeedforward,
@@ -368,12 +368,13 @@ def write_plan(result: SearchResult, planner: ClimbPlanner, out_traj: str | os.P
     after = _holds_after_steps(result, kin)
     segments = _sidecar_segments(result, timed, after)
     distances = palm_rail_distances(timed.configs, kin, planner.geom)
+    # A plan for rigid arms loads them beyond what a compliant arm gives: never PWM.
+    comply = arms_comply_while_gripping(planner.config.arm_strategy)
     arm_modes = {}
     for side in ARMS:
         holding = hand_holding_lines(segments, timed.line_count, side)
-        pwm = holding | (distances[side] <= PWM_RAIL_DISTANCE_M)
-        # A plan for rigid arms loads them beyond what a compliant arm gives.
-        arm_modes[side] = arm_mode_runs(pwm & (planner.config.arm_strategy != "position"))
+        arm_modes[side] = arm_mode_runs(
+            (holding | (distances[side] <= PWM_RAIL_DISTANCE_M)) & comply)
     feedforward = arm_feedforward(result, timed, after, planner.checker)
     metrics = _metrics(result, planner, timed, segments, clearance_every)
     metrics["palm_rail_pwm_distance_m"] = PWM_RAIL_DISTANCE_M
