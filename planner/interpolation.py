@@ -76,6 +76,27 @@ def contact_space_interpolate(kin: HuboKinematics, checker: FeasibilityChecker,
                       "torso_upright_weight": 0.0, "moving_tol_m": PROJECTION_TOL_M,
                       "moving_angle_tol_rad": ik_config.angle_tol_rad})
 
+    region = checker.region(stability_stance)
+    polygon = None if region.is_empty else region.clockwise_vertices()
+
+    def project(q0: np.ndarray, q1: np.ndarray, qm: np.ndarray, moving_targets,
+                com_polygon_cw: np.ndarray | None, depth: int):
+        """``qm`` projected onto the holds (its CoM pulled into ``com_polygon_cw`` if
+        given) and its verdict; raises if it does not project or jumps IK branch."""
+        span = kin.joint_distance(q0, q1)
+        res = solve_ik(kin, qm, support, moving_targets, posture_rad=kin.posture(qm),
+                       com_polygon_cw=com_polygon_cw, preferences=False, config=cfg)
+        stats.projections += 1
+        if not res.converged:
+            raise InterpolationError(f"projection failed: {res!r}", depth)
+        if max(kin.joint_distance(q0, res.q), kin.joint_distance(res.q, q1)) > JUMP_RATIO * span:
+            worst = int(np.argmax(np.abs(res.q[7:] - qm[7:])))
+            raise InterpolationError(
+                f"projection jumped to another IK branch at joint "
+                f"{kin.model.names[worst + 2]} ({qm[7 + worst]:.3f} → {res.q[7 + worst]:.3f} rad)",
+                depth)
+        return res.q, checker.check(res.q, stability_stance, contacts)
+
     def rec(q0: np.ndarray, q1: np.ndarray, depth: int) -> list[np.ndarray]:
         span = kin.joint_distance(q0, q1)
         if span <= resolution_rad:
@@ -89,22 +110,16 @@ def contact_space_interpolate(kin: HuboKinematics, checker: FeasibilityChecker,
                                                 kin.frame_pose(q1, h.frame), 0.5),
                  h.points_m, h.normals, h.friction)
             for h in moving)
-        res = solve_ik(kin, qm, support, moving_targets, posture_rad=kin.posture(qm),
-                       preferences=False, config=cfg)
-        stats.projections += 1
-        if not res.converged:
-            raise InterpolationError(f"projection failed: {res!r}", depth)
-        if max(kin.joint_distance(q0, res.q), kin.joint_distance(res.q, q1)) > JUMP_RATIO * span:
-            worst = int(np.argmax(np.abs(res.q[7:] - qm[7:])))
-            raise InterpolationError(
-                f"projection jumped to another IK branch at joint "
-                f"{kin.model.names[worst + 2]} ({qm[7 + worst]:.3f} → {res.q[7 + worst]:.3f} rad)",
-                depth)
-        verdict = checker.check(res.q, stability_stance, contacts)
+        q_mid, verdict = project(q0, q1, qm, moving_targets, None, depth)
+        if verdict.com_margin_m < 0 and polygon is not None:
+            # The CoM left the support region between two stable ends: project again,
+            # pulling the CoM into the region as the ends were found (only then: the
+            # polygon task slows every projection and bends paths that were fine).
+            q_mid, verdict = project(q0, q1, qm, moving_targets, polygon, depth)
         if not verdict.ok:
             raise InterpolationError(f"midpoint infeasible: {verdict.reason}", depth)
         stats.min_margin_m = min(stats.min_margin_m, verdict.com_margin_m)
         stats.max_torque_ratio = max(stats.max_torque_ratio, verdict.torque_ratio)
-        return rec(q0, res.q, depth + 1) + rec(res.q, q1, depth + 1)
+        return rec(q0, q_mid, depth + 1) + rec(q_mid, q1, depth + 1)
 
     return rec(qa, qb, 0)

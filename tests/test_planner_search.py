@@ -117,6 +117,32 @@ def test_interpolation_refuses_an_unstable_midpoint(planner, standing):
                                   {h.limb: h.target for h in stance.holds})
 
 
+def test_interpolation_pulls_a_midpoint_s_com_back_into_the_support_region():
+    """Two stable ends can have an unstable joint-space midpoint: raising both arms
+    forward-up from hanging swings them through horizontal, in front of the body. With
+    rigid arms, every DRC sample of the left hand's first move failed so (the CoM 0.2–1 cm
+    out) until the projection also pulled the CoM into the region."""
+    planner = ClimbPlanner(replace(load_ladder("drc"), placement_x_m=3.0), seed=1)  # clear
+    q, stance = planner.start_configuration()
+    kin, contacts = planner.kin, {h.limb: h.target for h in stance.holds}
+    leaning = solve_ik(kin, q, stance.holds, torso_R=planner.torso_R,
+                       pelvis_target_m=q[:3] + [0.05, 0.0, 0.0], pelvis_weight=1.0)
+    assert leaning.converged
+    arms_down = leaning.q.copy()
+    for side in "LR":
+        arms_down[kin.q_index[f"{side}SP"]], arms_down[kin.q_index[f"{side}EB"]] = 0.0, -0.2
+    arms_up = arms_down.copy()
+    for side in "LR":
+        arms_up[kin.q_index[f"{side}SP"]] = -3.0
+    for end in (arms_down, arms_up):
+        assert planner.checker.check(end, stance, contacts).ok
+    straight = planner.checker.check(kin.interpolate(arms_down, arms_up, 0.5), stance, contacts)
+    assert straight.com_margin_m < 0
+    path = contact_space_interpolate(kin, planner.checker, arms_down, arms_up, stance.holds,
+                                     stance, contacts)
+    assert all(planner.checker.check(qi, stance, contacts).ok for qi in path)
+
+
 def test_first_step_is_deterministic_for_a_seed():
     results = []
     for _ in range(2):
@@ -188,6 +214,17 @@ def test_stepping_onto_rung_0_with_compliant_arms_is_found():
     verdict = p.checker.check(q_end, new_stance, {h.limb: h.target for h in new_stance.holds})
     assert verdict.ok and verdict.torque_ratio <= 1.0
     assert {h.target for h in new_stance.holds if not h.is_hand} == {"rung_0"}
+
+
+def test_rigid_arms_climb_the_first_drc_rung():
+    """With rigid arms the straightened stance leans on both hands; every sample of the
+    left hand's first move then swung the CoM out of the support region at a midpoint
+    (or hit the rail), and ``plan-ladder drc --arm-strategy position`` failed there."""
+    p = ClimbPlanner(load_ladder("drc"), seed=1,
+                     config=PlannerConfig(arm_strategy="position", time_limit_s=90))
+    result = p.plan(top_rung=1)
+    assert {h.target for h in result.final_stance.holds if not h.is_hand} == {"rung_1"}
+    assert sum(st.backtracks for st in result.step_stats) == 0
 
 
 def test_stepping_off_the_floor_seeds_the_pelvis_as_high_as_the_floor_leg_reaches(
