@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 import logging
+import math
 import os
 import sys
 import time
@@ -91,8 +92,11 @@ def _summary_table(result, total_s: float, out) -> object:
                   f"{st.max_torque_ratio:.2f}")
     m = out.sidecar.metrics
     clear = m.get("min_clearance_m")
-    t.caption = (f"min clearance {clear * 100:.1f} cm" if clear is not None else
-                 "min clearance not measured")
+    turn = m.get("max_held_palm_turn_rad", {})
+    t.caption = ((f"min clearance {clear * 100:.1f} cm" if clear is not None else
+                  "min clearance not measured")
+                 + "; held palms turn on their rails up to "
+                 + ", ".join(f"{math.degrees(a):.1f}° ({side})" for side, a in turn.items()))
     return t
 
 

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import importlib.metadata
 import logging
+import math
 import os
 import time
 from collections.abc import Sequence
@@ -24,6 +25,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+import pinocchio as pin
 
 from planner.arm_capacity import DEFAULT_ARM_STRATEGY, arms_comply_while_gripping
 from robot.joints import ARM_JOINTS
@@ -46,7 +48,7 @@ if TYPE_CHECKING:
 
 log = logging.getLogger(__name__)
 
-__all__ = ["PWM_RAIL_DISTANCE_M", "PlanOutput", "arm_mode_runs",
+__all__ = ["PWM_RAIL_DISTANCE_M", "PlanOutput", "arm_mode_runs", "held_palm_turn_rad",
            "palm_rail_distances", "planner_version", "segment_paths", "step_groups",
            "write_plan"]
 
@@ -200,6 +202,40 @@ def palm_rail_distances(configs: np.ndarray, kin, geom) -> dict[str, np.ndarray]
         frame = "L_palm" if side == "left" else "R_palm"
         palms = np.array([kin.frame_pose(q, frame)[:3, 3] for q in configs])
         out[side] = np.linalg.norm(palms - geom.closest_rail_point(side, palms), axis=1)
+    return out
+
+
+def held_palm_turn_rad(configs: np.ndarray, kin, holding: dict[str, np.ndarray]
+                       ) -> dict[str, np.ndarray]:
+    """How far each held palm has turned since its hand closed on the rail, per line [rad].
+
+    The holds fix a palm's position and grip axis only, so a held hand may turn about its
+    rail from line to line; a closed grip resists that with its friction (8.3 N·m on the
+    DRC rails, `daemon.grasp_latch`), which a compliant arm cannot give.
+
+    Args:
+        configs: (N, nq) full configurations.
+        kin: `HuboKinematics`.
+        holding: arm → bool (N,) lines on which that hand holds its rail.
+
+    Returns:
+        arm → (N,) rotation angle of the palm from its orientation on the first line of
+        the current hold; 0 where the hand holds nothing.
+    """
+    frames = {side: kin.model.getFrameId("L_palm" if side == "left" else "R_palm")
+              for side in holding}
+    out = {side: np.zeros(len(configs)) for side in holding}
+    start: dict[str, np.ndarray] = {}
+    for i in np.flatnonzero(np.any(list(holding.values()), axis=0)):
+        pin.framesForwardKinematics(kin.model, kin.data, configs[i])
+        for side, held in holding.items():
+            if not held[i]:
+                continue
+            R = kin.data.oMf[frames[side]].rotation
+            if i == 0 or not held[i - 1]:  # the hand has just closed on its rail
+                start[side] = R.copy()
+            c = (np.trace(start[side].T @ R) - 1.0) / 2.0
+            out[side][i] = math.acos(min(1.0, max(-1.0, c)))
     return out
 
 
@@ -370,14 +406,15 @@ def write_plan(result: SearchResult, planner: ClimbPlanner, out_traj: str | os.P
     distances = palm_rail_distances(timed.configs, kin, planner.geom)
     # A plan for rigid arms loads them beyond what a compliant arm gives: never PWM.
     comply = arms_comply_while_gripping(planner.config.arm_strategy)
-    arm_modes = {}
-    for side in ARMS:
-        holding = hand_holding_lines(segments, timed.line_count, side)
-        arm_modes[side] = arm_mode_runs(
-            (holding | (distances[side] <= PWM_RAIL_DISTANCE_M)) & comply)
+    holding = {side: hand_holding_lines(segments, timed.line_count, side) for side in ARMS}
+    arm_modes = {side: arm_mode_runs((holding[side] | (distances[side] <= PWM_RAIL_DISTANCE_M))
+                                     & comply) for side in ARMS}
+    turn = held_palm_turn_rad(timed.configs, kin, holding)
     feedforward = arm_feedforward(result, timed, after, planner.checker)
     metrics = _metrics(result, planner, timed, segments, clearance_every)
     metrics["palm_rail_pwm_distance_m"] = PWM_RAIL_DISTANCE_M
+    metrics["max_held_palm_turn_rad"] = {side: float(turn[side].max()) for side in ARMS}
+    metrics["max_held_palm_turn_line"] = {side: int(np.argmax(turn[side])) + 1 for side in ARMS}
     metrics["arm_strategy"] = planner.config.arm_strategy
     out_traj = Path(out_traj)
     write_trajectory(out_traj, timed.columns_rad)

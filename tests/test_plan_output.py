@@ -26,7 +26,12 @@ from planner.output import (  # noqa: E402
 )
 from planner.search import SearchResult  # noqa: E402
 from robot.joints import ARM_JOINTS  # noqa: E402
-from robot.plan_sidecar import SidecarError, read_sidecar, sidecar_path  # noqa: E402
+from robot.plan_sidecar import (  # noqa: E402
+    SidecarError,
+    hand_holding_lines,
+    read_sidecar,
+    sidecar_path,
+)
 from robot.trajectory_file import read_trajectory  # noqa: E402
 
 
@@ -108,6 +113,18 @@ def test_palm_distances_match_the_rail_geometry(plan):
     assert d["left"][0] > PWM_RAIL_DISTANCE_M  # standing on the floor, hands down
 
 
+def test_held_palm_turn_counts_from_each_grasp(plan):
+    planner, _, q0 = plan
+    kin = planner.kin
+    configs = np.tile(q0, (8, 1))
+    wrist = kin.q_index["LWR"]
+    configs[:, wrist] += [0.0, 0.1, 0.2, 0.35, 0.5, 0.5, 0.6, 0.9]
+    held = np.array([0, 1, 1, 1, 0, 1, 1, 0], dtype=bool)  # two holds: lines 2–4, 6–7
+    turn = output.held_palm_turn_rad(configs, kin, {"left": held, "right": held & False})
+    np.testing.assert_allclose(turn["left"], [0, 0, 0.1, 0.25, 0, 0, 0.1, 0], atol=1e-9)
+    assert not turn["right"].any()
+
+
 def _closing_on_the_rails(result, monkeypatch) -> SearchResult:
     """The left palm closes in on its rail over the plan and the right hand holds its
     rail in the grasp segment."""
@@ -138,6 +155,11 @@ def test_mode_schedule_from_palm_distance_and_grasps(plan, tmp_path, monkeypatch
                                      (g.first_line, g.last_line, "pwm"),
                                      (g.last_line + 1, n, "position")]
     assert sc.metrics["min_clearance_m"] is None
+    # the sidecar reports how far each held palm turns on its rail (its fingers only
+    # close here, so neither turns)
+    holding = {arm: hand_holding_lines(sc.segments, n, arm) for arm in ("left", "right")}
+    turn = output.held_palm_turn_rad(out.timed.configs, planner.kin, holding)
+    assert sc.metrics["max_held_palm_turn_rad"] == {arm: t.max() for arm, t in turn.items()}
 
 
 def test_a_plan_for_rigid_arms_keeps_them_in_position_mode(plan, tmp_path, monkeypatch):
