@@ -4,7 +4,10 @@ MuJoCo friction alone cannot keep a five-finger hook grip on a round rail (libra
 a hand slid metres with default cones), and a real Hubo hand holds by closure rather
 than by friction alone. So a closed hand is *latched* to the ladder by a weld equality
 (one per hand, added to the spec inactive and switched through ``data.eq_active``), made
-at the hand's pose relative to the ladder at the moment it latches.
+at the hand's orientation relative to the ladder at the moment it latches, with the grip
+centre (the palm site) on the rail axis: fingers that close round a rail pull it into
+the middle of the grip. A hand that closed off-centre (a misplaced ladder, an arm that
+sagged) is drawn onto the axis; a compliant arm gives way, a stiff one fights the grip.
 
 When it latches (all of):
 
@@ -347,15 +350,18 @@ class GraspLatch:
         return d / np.linalg.norm(d)
 
     def _latch(self, rail: str) -> None:
-        """Weld hand ↔ ladder at their current relative pose."""
+        """Weld hand ↔ ladder at their current relative orientation, the palm site on the
+        rail axis."""
         m, d = self.model, self.data
         h, lad = self.body_id, self.ladder_body
         p = d.site_xpos[self.palm_site]
         R_h = d.xmat[h].reshape(3, 3)
         R_l = d.xmat[lad].reshape(3, 3)
         eq = m.eq_data[self.eq_id]
-        eq[0:3] = R_l.T @ (p - d.xpos[lad])  # anchor in the ladder (body2) frame
-        eq[3:6] = R_h.T @ (p - d.xpos[h])  # the same point in the hand (body1) frame
+        s0, s1, _ = self.rails[rail]
+        on_axis = _segment_closest(p, d.site_xpos[s0], d.site_xpos[s1])
+        eq[0:3] = R_l.T @ (on_axis - d.xpos[lad])  # anchor in the ladder (body2) frame
+        eq[3:6] = R_h.T @ (p - d.xpos[h])  # the palm site in the hand (body1) frame
         eq[6:10] = self._relpose(d.xquat[h])
         eq[10] = 1.0  # torquescale
         d.eq_active[self.eq_id] = 1

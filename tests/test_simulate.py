@@ -62,6 +62,24 @@ def test_fixture_climbs_in_mixed_without_warnings(plan):
     assert lat[-1]
 
 
+def test_a_stiff_arm_fights_a_grip_closed_off_centre_and_a_compliant_one_gives_way(plan):
+    """The ladder 3 cm further than planned: both hands still close within the 2 cm
+    tolerance (1.7 cm off the axis with rigid arms), and the closed fingers pull the rail
+    into the grip centre. Rigid arms fight that pull up to an arm joint's torque limit;
+    the mixed strategy's PWM arms give way."""
+    traj, sc, ladder = plan
+    misplaced = PlacementError(dx_m=0.03)
+    arms = [JOINT_INDEX[n] for n in ("LSP", "LSR", "LSY", "LEB", "RSP", "RSR", "RSY", "REB")]
+    peak = {}
+    for strategy in ("position", "mixed"):
+        run = simulate(traj, sc, ladder, SimulationOptions(strategy=strategy,
+                                                           placement=misplaced))
+        assert [g.kind for g in run.log.grasps] == ["latched", "latched"], run.log.grasps
+        limit = run.board.trips.torque_max_nm[arms]
+        peak[strategy] = float((np.abs(run.log.torque_nm[:, arms]) / limit).max())
+    assert peak["position"] >= 0.99 > 0.8 > peak["mixed"]
+
+
 def test_wrist_roll_trip_drops_the_fingers(plan):
     traj, sc, ladder = plan
     traj = traj.copy()
