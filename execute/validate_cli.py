@@ -149,10 +149,22 @@ def _run(args: argparse.Namespace) -> int:
     return 0 if run.verdict.climbed else 1
 
 
+def _joined_negative_values(argv: list[str]) -> list[str]:
+    """``--placement-error -0.03,0,0`` as ``--placement-error=-0.03,0,0``: argparse takes
+    a token that starts with '-' and is not a plain number for an option."""
+    out: list[str] = []
+    for token in argv:
+        if out and out[-1] == "--placement-error" and token.startswith("-"):
+            out[-1] = f"--placement-error={token}"
+        else:
+            out.append(token)
+    return out
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of ``validate-plan``; returns the exit code."""
     parser = _parser()
-    args = parser.parse_args(argv)
+    args = parser.parse_args(_joined_negative_values(sys.argv[1:] if argv is None else argv))
     if args.plots or args.video:
         os.environ.setdefault("MUJOCO_GL", "egl")  # before mujoco is imported
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,

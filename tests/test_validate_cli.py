@@ -55,6 +55,9 @@ def test_missing_sidecar_and_bad_options_exit_2(plan, tmp_path, capsys):
     assert "sidecar" in capsys.readouterr().err
     assert main([str(plan), "--placement-error", "1,2"]) == 2
     assert "placement-error" in capsys.readouterr().err
+    # a negative misplacement is a value, not an option
+    assert main([str(plan), "--placement-error", "-1,2"]) == 2
+    assert "'-1,2': expected three numbers" in capsys.readouterr().err
     assert main([str(plan), "--battery", "300"]) == 2
     assert "battery" in capsys.readouterr().err
 
