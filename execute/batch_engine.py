@@ -5,7 +5,8 @@ runner (`execute.batch_runner`) has one code path and ships the same module-leve
 functions to either.
 
 - ``local``: `concurrent.futures.ProcessPoolExecutor` with ``workers`` processes, started
-  by a fork server (the parent has a progress-bar thread; forking it is unsafe). One
+  by a fork server (the parent has a progress-bar thread; forking it is unsafe), a fresh
+  process for every job (`local_engine`). One
   worker dying breaks the whole pool (`BrokenProcessPool`); the runner then calls
   `Engine.restart`.
 - ``dask``: ``distributed.Client(address)`` against a running scheduler, or a
@@ -79,12 +80,23 @@ class Engine:
         return f"Engine({self.description})"
 
 
+#: Imported once by the fork server, so that a fresh process per job starts warm.
+FORKSERVER_PRELOAD = ("planner.search", "planner.output", "execute.simulate")
+
+
 def local_engine(workers: int) -> Engine:
-    """A local process pool of ``workers`` processes."""
+    """A local process pool of ``workers`` processes, a fresh one for every job.
+
+    A fresh process per job keeps a batch cell identical to ``plan-ladder`` with its
+    seed: OMPL's random numbers can be seeded only once per process
+    (`planner.limb_rrt`), so a worker that had planned before would draw on from where
+    its previous jobs left them. The fork server imports the heavy modules once.
+    """
     ctx = multiprocessing.get_context("forkserver")
+    ctx.set_forkserver_preload(list(FORKSERVER_PRELOAD))  # no effect once it has started
 
     def make() -> ProcessPoolExecutor:
-        return ProcessPoolExecutor(max_workers=workers, mp_context=ctx)
+        return ProcessPoolExecutor(max_workers=workers, mp_context=ctx, max_tasks_per_child=1)
 
     def restart(old: Executor) -> Executor:
         old.shutdown(wait=False, cancel_futures=True)

@@ -9,6 +9,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+import os
 import sys
 from pathlib import Path
 
@@ -188,6 +189,14 @@ def test_results_log_survives_a_torn_last_line(tmp_path):
 def engine():
     with local_engine(2) as eng:
         yield eng
+
+
+def test_every_job_runs_in_a_fresh_process():
+    """OMPL is seeded once per process: a worker reused across plans would make a batch
+    cell differ from plan-ladder with the same seed."""
+    with local_engine(1) as eng:
+        pids = [eng.submit(os.getpid).result() for _ in range(3)]
+    assert len(set(pids)) == 3 and os.getpid() not in pids
 
 
 def _lines(out: Path) -> list[dict]:
