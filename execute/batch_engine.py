@@ -6,9 +6,8 @@ functions to either.
 
 - ``local``: `concurrent.futures.ProcessPoolExecutor` with ``workers`` processes, started
   by a fork server (the parent has a progress-bar thread; forking it is unsafe), a fresh
-  process for every job (`local_engine`). One
-  worker dying breaks the whole pool (`BrokenProcessPool`); the runner then calls
-  `Engine.restart`.
+  process for every job (`local_engine`). One worker dying breaks the whole pool
+  (`BrokenProcessPool`); the runner then calls `Engine.restart`.
 - ``dask``: ``distributed.Client(address)`` against a running scheduler, or a
   ``LocalCluster`` of ``workers`` single-threaded worker processes when no address is
   given (``processes=False`` runs the workers as threads, for tests). Dask retries a

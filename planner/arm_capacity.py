@@ -29,8 +29,7 @@ from robot.pwm_gains import safe_default_gain_table
 
 __all__ = ["ARM_STRATEGIES", "BACK_EMF_SHARE", "DEFAULT_ARM_STRATEGY",
            "arms_comply_while_gripping", "compliant_speed_rad_s", "compliant_torque_nm",
-           "gripping_sides",
-           "gripping_torque_limits", "gripping_velocity_limits"]
+           "gripping_sides", "gripping_torque_limits", "gripping_velocity_limits"]
 
 ARM_STRATEGIES = ("mixed", "position")
 DEFAULT_ARM_STRATEGY = "mixed"

@@ -92,11 +92,11 @@ def _summary_table(result, total_s: float, out) -> object:
                   f"{st.max_torque_ratio:.2f}")
     m = out.sidecar.metrics
     clear = m.get("min_clearance_m")
-    turn = m.get("max_held_palm_turn_rad", {})
-    t.caption = ((f"min clearance {clear * 100:.1f} cm" if clear is not None else
-                  "min clearance not measured")
-                 + "; held palms turn on their rails up to "
-                 + ", ".join(f"{math.degrees(a):.1f}° ({side})" for side, a in turn.items()))
+    t.caption = (f"min clearance {clear * 100:.1f} cm" if clear is not None else
+                 "min clearance not measured")
+    if turn := m.get("max_held_palm_turn_rad"):
+        t.caption += "; held palms turn on their rails up to " + ", ".join(
+            f"{math.degrees(a):.1f}° ({side})" for side, a in turn.items())
     return t
 
 

@@ -76,14 +76,10 @@ def contact_space_interpolate(kin: HuboKinematics, checker: FeasibilityChecker,
                       "torso_upright_weight": 0.0, "moving_tol_m": PROJECTION_TOL_M,
                       "moving_angle_tol_rad": ik_config.angle_tol_rad})
 
-    region = checker.region(stability_stance)
-    polygon = None if region.is_empty else region.clockwise_vertices()
-
-    def project(q0: np.ndarray, q1: np.ndarray, qm: np.ndarray, moving_targets,
+    def project(q0: np.ndarray, q1: np.ndarray, span: float, qm: np.ndarray, moving_targets,
                 com_polygon_cw: np.ndarray | None, depth: int):
         """``qm`` projected onto the holds (its CoM pulled into ``com_polygon_cw`` if
         given) and its verdict; raises if it does not project or jumps IK branch."""
-        span = kin.joint_distance(q0, q1)
         res = solve_ik(kin, qm, support, moving_targets, posture_rad=kin.posture(qm),
                        com_polygon_cw=com_polygon_cw, preferences=False, config=cfg)
         stats.projections += 1
@@ -110,13 +106,15 @@ def contact_space_interpolate(kin: HuboKinematics, checker: FeasibilityChecker,
                                                 kin.frame_pose(q1, h.frame), 0.5),
                  h.points_m, h.normals, h.friction)
             for h in moving)
-        q_mid, verdict = project(q0, q1, qm, moving_targets, None, depth)
-        if verdict.com_margin_m < 0 and polygon is not None:
+        q_mid, verdict = project(q0, q1, span, qm, moving_targets, None, depth)
+        region = checker.region(stability_stance) if verdict.com_margin_m < 0 else None
+        if region is not None and not region.is_empty:
             # The CoM left the support region between two stable ends: project again,
             # pulling the CoM into the region as the ends were found. Only then: on every
             # projection it also bent paths that were fine (the DRC seed 1 climb took
             # 1486 s of motion instead of 1278 s).
-            q_mid, verdict = project(q0, q1, qm, moving_targets, polygon, depth)
+            q_mid, verdict = project(q0, q1, span, qm, moving_targets,
+                                     region.clockwise_vertices(), depth)
         if not verdict.ok:
             raise InterpolationError(f"midpoint infeasible: {verdict.reason}", depth)
         stats.min_margin_m = min(stats.min_margin_m, verdict.com_margin_m)

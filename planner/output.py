@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import importlib.metadata
 import logging
-import math
 import os
 import time
 from collections.abc import Sequence
@@ -49,7 +48,7 @@ if TYPE_CHECKING:
 log = logging.getLogger(__name__)
 
 __all__ = ["PWM_RAIL_DISTANCE_M", "PlanOutput", "arm_mode_runs", "held_palm_turn_rad",
-           "palm_rail_distances", "planner_version", "segment_paths", "step_groups",
+           "palm_poses", "palm_rail_distances", "planner_version", "segment_paths", "step_groups",
            "write_plan"]
 
 #: An arm is compliant (PWM) while its palm is this close to its rail's axis [m].
@@ -189,23 +188,35 @@ def _holds_after_steps(result: SearchResult, kin) -> list[dict[str, Hold]]:
     return out
 
 
-def palm_rail_distances(configs: np.ndarray, kin, geom) -> dict[str, np.ndarray]:
-    """Distance of each palm to its own side's rail axis, per line [m].
+def palm_poses(configs: np.ndarray, kin) -> dict[str, np.ndarray]:
+    """Each palm's pose per line, arm → (N, 4, 4): one forward kinematics per line.
 
     Args:
         configs: (N, nq) full configurations.
         kin: `HuboKinematics` (palm frames ``L_palm``/``R_palm``).
-        geom: `LadderGeometry` (``closest_rail_point``).
     """
-    out = {}
-    for side in ARMS:
-        frame = "L_palm" if side == "left" else "R_palm"
-        palms = np.array([kin.frame_pose(q, frame)[:3, 3] for q in configs])
-        out[side] = np.linalg.norm(palms - geom.closest_rail_point(side, palms), axis=1)
+    frames = {side: kin.model.getFrameId("L_palm" if side == "left" else "R_palm")
+              for side in ARMS}
+    out = {side: np.empty((len(configs), 4, 4)) for side in ARMS}
+    for i, q in enumerate(configs):
+        pin.framesForwardKinematics(kin.model, kin.data, q)
+        for side, fid in frames.items():
+            out[side][i] = kin.data.oMf[fid].homogeneous
     return out
 
 
-def held_palm_turn_rad(configs: np.ndarray, kin, holding: dict[str, np.ndarray]
+def palm_rail_distances(palms: dict[str, np.ndarray], geom) -> dict[str, np.ndarray]:
+    """Distance of each palm to its own side's rail axis, per line [m].
+
+    Args:
+        palms: arm → (N, 4, 4) palm poses (`palm_poses`).
+        geom: `LadderGeometry` (``closest_rail_point``).
+    """
+    return {side: np.linalg.norm(T[:, :3, 3] - geom.closest_rail_point(side, T[:, :3, 3]),
+                                 axis=1) for side, T in palms.items()}
+
+
+def held_palm_turn_rad(palms: dict[str, np.ndarray], holding: dict[str, np.ndarray]
                        ) -> dict[str, np.ndarray]:
     """How far each held palm has turned since its hand closed on the rail, per line [rad].
 
@@ -214,28 +225,20 @@ def held_palm_turn_rad(configs: np.ndarray, kin, holding: dict[str, np.ndarray]
     DRC rails, `daemon.grasp_latch`), which a compliant arm cannot give.
 
     Args:
-        configs: (N, nq) full configurations.
-        kin: `HuboKinematics`.
+        palms: arm → (N, 4, 4) palm poses (`palm_poses`).
         holding: arm → bool (N,) lines on which that hand holds its rail.
 
     Returns:
         arm → (N,) rotation angle of the palm from its orientation on the first line of
         the current hold; 0 where the hand holds nothing.
     """
-    frames = {side: kin.model.getFrameId("L_palm" if side == "left" else "R_palm")
-              for side in holding}
-    out = {side: np.zeros(len(configs)) for side in holding}
-    start: dict[str, np.ndarray] = {}
-    for i in np.flatnonzero(np.any(list(holding.values()), axis=0)):
-        pin.framesForwardKinematics(kin.model, kin.data, configs[i])
-        for side, held in holding.items():
-            if not held[i]:
-                continue
-            R = kin.data.oMf[frames[side]].rotation
-            if i == 0 or not held[i - 1]:  # the hand has just closed on its rail
-                start[side] = R.copy()
-            c = (np.trace(start[side].T @ R) - 1.0) / 2.0
-            out[side][i] = math.acos(min(1.0, max(-1.0, c)))
+    out = {}
+    for side, held in holding.items():
+        R = palms[side][:, :3, :3]
+        grasped = held & ~np.r_[False, held[:-1]]  # the hand has just closed on its rail
+        first = np.maximum.accumulate(np.where(grasped, np.arange(len(held)), 0))
+        cos = (np.einsum("nij,nij->n", R[first], R) - 1.0) / 2.0  # trace(R0ᵀ R)
+        out[side] = np.where(held, np.arccos(np.clip(cos, -1.0, 1.0)), 0.0)
     return out
 
 
@@ -403,13 +406,14 @@ def write_plan(result: SearchResult, planner: ClimbPlanner, out_traj: str | os.P
     t_timed = time.perf_counter()
     after = _holds_after_steps(result, kin)
     segments = _sidecar_segments(result, timed, after)
-    distances = palm_rail_distances(timed.configs, kin, planner.geom)
+    palms = palm_poses(timed.configs, kin)
+    distances = palm_rail_distances(palms, planner.geom)
     # A plan for rigid arms loads them beyond what a compliant arm gives: never PWM.
     comply = arms_comply_while_gripping(planner.config.arm_strategy)
     holding = {side: hand_holding_lines(segments, timed.line_count, side) for side in ARMS}
     arm_modes = {side: arm_mode_runs((holding[side] | (distances[side] <= PWM_RAIL_DISTANCE_M))
                                      & comply) for side in ARMS}
-    turn = held_palm_turn_rad(timed.configs, kin, holding)
+    turn = held_palm_turn_rad(palms, holding)
     feedforward = arm_feedforward(result, timed, after, planner.checker)
     metrics = _metrics(result, planner, timed, segments, clearance_every)
     metrics["palm_rail_pwm_distance_m"] = PWM_RAIL_DISTANCE_M

@@ -106,7 +106,8 @@ def test_arm_mode_runs():
 
 def test_palm_distances_match_the_rail_geometry(plan):
     planner, result, q0 = plan
-    d = output.palm_rail_distances(np.array([q0]), planner.kin, planner.geom)
+    d = output.palm_rail_distances(output.palm_poses(np.array([q0]), planner.kin),
+                                   planner.geom)
     palm = planner.kin.frame_pose(q0, "L_palm")[:3, 3]
     expect = np.linalg.norm(palm - planner.geom.closest_rail_point("left", palm))
     assert d["left"][0] == pytest.approx(expect)
@@ -120,7 +121,8 @@ def test_held_palm_turn_counts_from_each_grasp(plan):
     wrist = kin.q_index["LWR"]
     configs[:, wrist] += [0.0, 0.1, 0.2, 0.35, 0.5, 0.5, 0.6, 0.9]
     held = np.array([0, 1, 1, 1, 0, 1, 1, 0], dtype=bool)  # two holds: lines 2–4, 6–7
-    turn = output.held_palm_turn_rad(configs, kin, {"left": held, "right": held & False})
+    turn = output.held_palm_turn_rad(output.palm_poses(configs, kin),
+                                     {"left": held, "right": held & False})
     np.testing.assert_allclose(turn["left"], [0, 0, 0.1, 0.25, 0, 0, 0.1, 0], atol=1e-9)
     assert not turn["right"].any()
 
@@ -128,8 +130,8 @@ def test_held_palm_turn_counts_from_each_grasp(plan):
 def _closing_on_the_rails(result, monkeypatch) -> SearchResult:
     """The left palm closes in on its rail over the plan and the right hand holds its
     rail in the grasp segment."""
-    def fake(configs, kin, geom):
-        n = len(configs)
+    def fake(palms, geom):
+        n = len(palms["left"])
         return {"left": np.linspace(0.10, 0.0, n), "right": np.full(n, 0.2)}
 
     monkeypatch.setattr(output, "palm_rail_distances", fake)
@@ -158,7 +160,8 @@ def test_mode_schedule_from_palm_distance_and_grasps(plan, tmp_path, monkeypatch
     # the sidecar reports how far each held palm turns on its rail (its fingers only
     # close here, so neither turns)
     holding = {arm: hand_holding_lines(sc.segments, n, arm) for arm in ("left", "right")}
-    turn = output.held_palm_turn_rad(out.timed.configs, planner.kin, holding)
+    turn = output.held_palm_turn_rad(output.palm_poses(out.timed.configs, planner.kin),
+                                     holding)
     assert sc.metrics["max_held_palm_turn_rad"] == {arm: t.max() for arm, t in turn.items()}
 
 
