@@ -75,6 +75,9 @@ __all__ = ["RELEASE_LOADS", "SLIP_LOADS", "GraspEvent", "GraspLatch", "GripCapac
 
 #: Finger positions along the grip axis [m] (robot.kinematic_tree: −0.036 + 0.018·i).
 FINGER_X_M = (-0.036, -0.018, 0.0, 0.018, 0.036)
+#: ``efc_type`` of an equality's constraint rows as a plain int: numpy compares an array
+#: with the binding's enum object element by element, a hundred times slower.
+_EQUALITY_ROW = int(mujoco.mjtConstraint.mjCNSTR_EQUALITY)
 
 
 @dataclass(frozen=True)
@@ -124,10 +127,10 @@ class GripCapacity:
         fa = float(force_n @ axis)
         ta = float(torque_nm @ axis)
         return {
-            "radial force": float(np.linalg.norm(force_n - fa * axis)) / self.radial_n,
+            "radial force": _norm(force_n - fa * axis) / self.radial_n,
             "force along the rail": abs(fa) / self.axial_n,
             "torque about the rail": abs(ta) / self.roll_nm,
-            "bending torque": float(np.linalg.norm(torque_nm - ta * axis)) / self.bending_nm,
+            "bending torque": _norm(torque_nm - ta * axis) / self.bending_nm,
         }
 
 
@@ -167,6 +170,18 @@ def _conj(q: np.ndarray) -> np.ndarray:
     return out
 
 
+def _mean(values: np.ndarray) -> float:
+    """``float(np.mean(values))`` of a 1-D float64 array, the same sum and division
+    without np.mean's overhead (several calls a tick)."""
+    return float(np.add.reduce(values)) / len(values)
+
+
+def _norm(v: np.ndarray) -> float:
+    """``float(np.linalg.norm(v))`` of a 1-D float64 vector, the same dot product and
+    square root without its overhead."""
+    return math.sqrt(v.dot(v))
+
+
 def _segment_closest(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     d = b - a
     t = float(np.clip((p - a) @ d / (d @ d), 0.0, 1.0))
@@ -204,8 +219,7 @@ class GraspLatch:
         self.rails = rails
         self.friction, self.rail_radius_m = friction, rail_radius_m
         self.capacity = GripCapacity.of(self.config, friction, rail_radius_m)
-        self._jacp = np.zeros((3, model.nv))
-        self._jacr = np.zeros((3, model.nv))
+        self._jac = np.zeros((6, model.nv))  # palm site: translation rows, rotation rows
         self._qfrc = np.zeros(model.nv)
         self.reset()
 
@@ -241,14 +255,13 @@ class GraspLatch:
         """Weld wrench on the hand about the palm site: force [N], torque [N·m] (world)."""
         m, d = self.model, self.data
         n = d.nefc
-        rows = (d.efc_type[:n] == mujoco.mjtConstraint.mjCNSTR_EQUALITY) & \
-            (d.efc_id[:n] == self.eq_id)
+        rows = (d.efc_type[:n] == _EQUALITY_ROW) & (d.efc_id[:n] == self.eq_id)
         if not rows.any():
             return np.zeros(3), np.zeros(3)
         f = np.where(rows, d.efc_force[:n], 0.0)
         mujoco.mj_mulJacTVec(m, d, self._qfrc, f)
-        mujoco.mj_jac(m, d, self._jacp, self._jacr, d.site_xpos[self.palm_site], self.body_id)
-        J = np.vstack([self._jacp, self._jacr])
+        J = self._jac
+        mujoco.mj_jac(m, d, J[:3], J[3:], d.site_xpos[self.palm_site], self.body_id)
         w = np.linalg.lstsq(J.T, self._qfrc, rcond=None)[0]
         return w[:3], w[3:]
 
@@ -257,9 +270,10 @@ class GraspLatch:
                finger_board_ok: bool) -> GraspEvent | None:
         """One check after a tick. ``finger_ref_rad`` is the sent finger reference (5,)."""
         cfg = self.config
-        closed_ref = float(np.mean(finger_ref_rad)) >= cfg.closed_fraction * FINGER_CLOSED_RAD
-        opening = float(np.mean(finger_ref_rad)) < cfg.open_fraction * FINGER_CLOSED_RAD
-        curl = float(np.mean(self.data.qpos[self.finger_qpos]))
+        ref_mean_rad = _mean(finger_ref_rad)
+        closed_ref = ref_mean_rad >= cfg.closed_fraction * FINGER_CLOSED_RAD
+        opening = ref_mean_rad < cfg.open_fraction * FINGER_CLOSED_RAD
+        curl = _mean(self.data.qpos[self.finger_qpos])
         if self.state is GripState.LATCHED:
             if not finger_board_ok:
                 return self._release(time_s, "its finger board tripped: no finger torque, "
@@ -347,7 +361,7 @@ class GraspLatch:
     def _rail_axis(self, rail: str) -> np.ndarray:
         s0, s1, _ = self.rails[rail]
         d = self.data.site_xpos[s1] - self.data.site_xpos[s0]
-        return d / np.linalg.norm(d)
+        return d / _norm(d)
 
     def _latch(self, rail: str) -> None:
         """Weld hand ↔ ladder at their current relative orientation, the palm site on the
