@@ -64,6 +64,10 @@ class RefMode(IntEnum):
     ENCODER_FILTER = 3  #: filter from the encoder position towards the reference
 
 
+#: The mode values, for membership tests on mode arrays.
+_MODE_VALUES = np.array([m.value for m in RefMode])
+
+
 class ReferenceModeError(InputError):
     """A reference mode outside 0..3 (or a malformed mode array) reached the control law."""
 
@@ -117,7 +121,7 @@ def validate_modes(mode: int | np.ndarray) -> np.ndarray:
         arr = np.full(NUM_JOINTS, arr)
     if arr.shape != (NUM_JOINTS,):
         raise ReferenceModeError(f"mode has shape {arr.shape}; expected () or ({NUM_JOINTS},)")
-    valid = np.isin(arr, [m.value for m in RefMode])
+    valid = (arr[:, None] == _MODE_VALUES).any(axis=1)  # np.isin's test, without its setup
     if not valid.all():
         bad = [f"{JOINT_NAMES[i]}={arr[i].item()!r}" for i in np.flatnonzero(~valid)]
         raise ReferenceModeError(
@@ -148,11 +152,12 @@ def filter_reference(
     """
     keep = (filter_length - 1.0) / filter_length
     gain = 1.0 / filter_length
-    return np.select(
-        [mode == RefMode.FILTER, mode == RefMode.DIRECT, mode == RefMode.COMPLIANT],
-        [prev_sent_rad * keep + ref_rad * gain, ref_rad, pos_rad],
-        default=pos_rad * keep + ref_rad * gain,  # ENCODER_FILTER
-    )
+    # Chained np.where rather than np.select (a quarter of the time per tick); plain ints
+    # (`.value`) spare numpy the enum class's attribute lookups. Any value outside
+    # FILTER, DIRECT, COMPLIANT gets ENCODER_FILTER.
+    sent = np.where(mode == RefMode.COMPLIANT.value, pos_rad, pos_rad * keep + ref_rad * gain)
+    sent = np.where(mode == RefMode.DIRECT.value, ref_rad, sent)
+    return np.where(mode == RefMode.FILTER.value, prev_sent_rad * keep + ref_rad * gain, sent)
 
 
 def rigid_return_step(

@@ -79,6 +79,13 @@ class ComplianceState(IntEnum):
     RETURNING = 2  #: position mode, slow return towards the reference (L = 400)
 
 
+#: The states as plain ints for the per-tick array operations: given an enum member,
+#: numpy looks attributes up on its class, which costs more than the operation.
+_RIGID = ComplianceState.RIGID.value
+_COMPLIANT = ComplianceState.COMPLIANT.value
+_RETURNING = ComplianceState.RETURNING.value
+
+
 class ControlInputError(InputError):
     """A tick input has the wrong shape or a non-finite value; names the joints."""
 
@@ -252,15 +259,17 @@ class JointController:
         state = self._state
 
         want_pwm = comply & self.compliance_capable
-        was_pwm = state == ComplianceState.COMPLIANT
-        leaving = was_pwm & ~want_pwm
-        returning = (state == ComplianceState.RETURNING) & ~want_pwm
+        leaving = (state == _COMPLIANT) & ~want_pwm
+        returning = (state == _RETURNING) & ~want_pwm
 
         sent = filter_reference(modes, ref, prev, pos, self.config.filter_length)
-        back_sent, back_done = rigid_return_step(prev, ref, self.config)
-        still_returning = returning & ~back_done
-        sent = np.where(still_returning, back_sent, sent)
-        sent = np.where(leaving, pos, sent)  # first tick out of PWM starts from the encoder
+        still_returning = returning  # the two steps below only on ticks that need them
+        if returning.any():
+            back_sent, back_done = rigid_return_step(prev, ref, self.config)
+            still_returning = returning & ~back_done
+            sent = np.where(still_returning, back_sent, sent)
+        if leaving.any():
+            sent = np.where(leaving, pos, sent)  # first tick out of PWM starts from the encoder
         sent, sent_clamped = clamp_reference(sent, lower, upper)
 
         duty, saturated = pwm_duty(sent, pos, vel, gains, command)
@@ -268,9 +277,9 @@ class JointController:
         saturated &= want_pwm
         limp = want_pwm & (((gains.kp == 0) & (gains.kd == 0)) | (gains.max_pwm_pct == 0))
 
-        new_state = np.full(NUM_JOINTS, ComplianceState.RIGID, dtype=np.int8)
-        new_state[want_pwm] = ComplianceState.COMPLIANT
-        new_state[leaving | still_returning] = ComplianceState.RETURNING
+        new_state = np.full(NUM_JOINTS, _RIGID, dtype=np.int8)
+        new_state[want_pwm] = _COMPLIANT
+        new_state[leaving | still_returning] = _RETURNING
 
         self._sent_rad = sent
         self._state = new_state
@@ -278,7 +287,7 @@ class JointController:
             ref_sent_rad=sent.copy(),
             duty_pct=duty,
             pwm=want_pwm.copy(),
-            returning=new_state == ComplianceState.RETURNING,
+            returning=new_state == _RETURNING,
             limp=limp,
             duty_saturated=saturated,
             limit_clamped=ref_clamped | sent_clamped,
