@@ -105,6 +105,10 @@ class BoardTripMonitor:
         for b, joints in enumerate(self._board_names):
             for j in BOARDS[joints]:
                 self._board_of[JOINT_INDEX[j]] = b
+        # Per-tick thresholds, once (limits, exemptions and config are fixed from here).
+        self._overload_nm = self.config.saturation_fraction * self.torque_max_nm
+        self._watched = (self.torque_max_nm > 0) & ~self.exempt
+        self._trip_s = self.config.trip_after_s - 1e-12
         self.reset()
 
     def reset(self) -> None:
@@ -118,12 +122,10 @@ class BoardTripMonitor:
         """Accounts ``dt_s`` of the joint torques ``torque_nm`` [N·m]; returns new trips."""
         mag = np.abs(torque_nm)
         np.maximum(self.peak_torque_nm, mag, out=self.peak_torque_nm)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            over = (mag >= self.config.saturation_fraction * self.torque_max_nm) & \
-                (self.torque_max_nm > 0) & ~self.tripped & ~self.exempt
+        over = (mag >= self._overload_nm) & self._watched & ~self.tripped
         self.overload_s = np.where(over, self.overload_s + dt_s, 0.0)
         new: list[TripEvent] = []
-        for j in np.flatnonzero(self.overload_s >= self.config.trip_after_s - 1e-12):
+        for j in np.flatnonzero(self.overload_s >= self._trip_s):
             b = self._board_of[j]
             if b < 0 or self.tripped[j]:
                 continue

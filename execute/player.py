@@ -394,6 +394,9 @@ class TrajectoryPlayer:
                 mask[arm_idx["right"]] = right
                 mask.setflags(write=False)
                 self._comply[(left, right)] = mask
+        self._arm_modes = {(left, right): MappingProxyType({"left": ARM_MODES[left],
+                                                            "right": ARM_MODES[right]})
+                           for left, right in self._comply}
         if feedforward is not None and len(feedforward.torque_nm) != feedforward.rows_for(n):
             raise ModeScheduleError(
                 f"feed-forward has {len(feedforward.torque_nm)} rows; {n} lines every "
@@ -537,7 +540,7 @@ class TrajectoryPlayer:
             feedforward_nm=feedforward,
             velocity_rad_s=velocity,
             line_index=row,
-            arm_modes=MappingProxyType({"left": ARM_MODES[left], "right": ARM_MODES[right]}),
+            arm_modes=self._arm_modes[(left, right)],
             going_to_init=going_to_init,
             paused=self.paused,
             finished=finished,
@@ -569,7 +572,7 @@ class TrajectoryPlayer:
         for arm, arm_pwm in zip(ARMS, pwm, strict=True):
             if arm_pwm and self._holding[arm][row]:
                 mode = mode.copy() if mode is self._mode else mode
-                mode[self._force_cols[arm]] = RefMode.COMPLIANT
+                mode[self._force_cols[arm]] = RefMode.COMPLIANT.value  # an int is cheaper for numpy
         return feedforward, velocity, mode
 
     def _filter_velocity(self, ref: np.ndarray, going_to_init: bool) -> np.ndarray:
