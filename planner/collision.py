@@ -32,7 +32,7 @@ def _shape(g: Geom) -> tuple[coal.CollisionGeometry, np.ndarray]:
     if g.kind == "capsule":
         p0, p1 = np.asarray(g.p0), np.asarray(g.p1)
         length = float(np.linalg.norm(p1 - p0))
-        return coal.Capsule(g.radius, length / 2), (p0 + p1) / 2
+        return coal.Capsule(g.radius, length), (p0 + p1) / 2  # coal takes the full length
     if g.kind == "box":
         return coal.Box(*(2 * np.asarray(g.half))), np.asarray(g.p0)
     return coal.Sphere(g.radius), np.asarray(g.p0)

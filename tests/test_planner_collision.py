@@ -1,0 +1,67 @@
+"""The planner's collision geometry is the robot's: coal and the MuJoCo scene agree."""
+
+from types import SimpleNamespace
+
+import mujoco
+import numpy as np
+import pinocchio as pin
+
+from ladders.collision import ladder_collision_objects
+from ladders.loader import load_ladder
+from ladders.scene import build_scene
+from planner.collision import CollisionModel
+from robot.mjcf import ROBOT_CONTYPE, joint_qpos_addresses
+from robot.params import robot_params
+from robot.urdf import robot_urdf
+
+
+def test_planner_and_simulator_measure_the_same_distances_to_the_rungs():
+    """Over random poses in front of the DRC ladder, each robot body's distance to each
+    rung is the same in the planner's coal model and in the MuJoCo scene (a capsule of
+    the wrong length in either would show as centimetres)."""
+    spec = load_ladder("drc")
+    params = robot_params("drc-hubo")
+    model = pin.buildModelFromXML(robot_urdf(params), pin.JointModelFreeFlyer())
+    data = model.createData()
+    planner = CollisionModel(SimpleNamespace(model=model, data=data, params=params),
+                             ladder_collision_objects(spec))
+    mj = build_scene(spec, params).compile()
+    mjd = mujoco.MjData(mj)
+    qadr = joint_qpos_addresses(mj)
+    rungs = [f"rung_{k}" for k in range(3)]
+    rung_geoms = {r: mujoco.mj_name2id(mj, mujoco.mjtObj.mjOBJ_GEOM, r) for r in rungs}
+    body_geoms: dict[str, list[int]] = {}
+    for g in range(mj.ngeom):
+        if mj.geom_contype[g] == ROBOT_CONTYPE:
+            body_geoms.setdefault(mj.body(mj.geom_bodyid[g]).name, []).append(g)
+    rng = np.random.default_rng(3)
+    compared = 0
+    for _ in range(15):
+        q = pin.randomConfiguration(model)
+        q[:3] = (rng.uniform(0.0, 0.25), rng.uniform(-0.1, 0.1), rng.uniform(0.8, 1.2))
+        q[3:7] = (0.0, 0.0, 0.0, 1.0)
+        pin.computeDistances(model, data, planner.geom, planner.gdata, q)
+        coal_m: dict[tuple[str, str], float] = {}
+        for k, cp in enumerate(planner.geom.collisionPairs):
+            a = planner.geom.geometryObjects[cp.first].name
+            b = planner.geom.geometryObjects[cp.second].name
+            if b in rungs:
+                key = (a.split("/")[0], b)
+                coal_m[key] = min(coal_m.get(key, np.inf),
+                                  planner.gdata.distanceResults[k].min_distance)
+        mjd.qpos[:3] = q[:3]
+        mjd.qpos[3:7] = (1.0, 0.0, 0.0, 0.0)
+        for j in range(2, model.njoints):
+            mjd.qpos[qadr[model.names[j]]] = q[model.joints[j].idx_q]
+        mujoco.mj_kinematics(mj, mjd)
+        for (body, rung), d_coal in coal_m.items():
+            if d_coal > 0.3:
+                continue
+            d_mj = min(mujoco.mj_geomDistance(mj, mjd, g, rung_geoms[rung], 0.5, None)
+                       for g in body_geoms[body])
+            if d_coal <= 0.0:  # in contact: both say so (penetration depths differ)
+                assert d_mj <= 1e-4, (body, rung, d_mj, d_coal)
+            else:
+                assert abs(d_mj - d_coal) < 1e-4, (body, rung, d_mj, d_coal)
+            compared += 1
+    assert compared > 50
