@@ -35,28 +35,40 @@ weld's anchor is moved about (or along) the rail, by the share of the hand's off
 from it that leaves the weld's spring carrying only the capacity. `slip_rad` and
 `slip_m` add up how far the hand turned and slid.
 
-Grip capacity, from the fingers' torque limit (hubo-facts §5: ≈ 5 N·m each):
+The fingers close round the rail and press it with ``finger_squeeze_nm`` each, 1 N·m by
+default, a fifth of their limit:
 
-======================  ================================  ========================
-load on the hand        capacity                          DRC-Hubo, μ = 0.4
-======================  ================================  ========================
-radial force            ``N = n·τ_f / ℓ``                 5·5/0.06 = 417 N
-force along the rail    ``2μ·N`` (fingers + palm rub)     333 N
-torque about the rail   ``2μ·N·r_rail``                   8.3 N·m (r = 25 mm)
-bending torque          ``(τ_f/ℓ)·Σ|x_i|`` (finger couple)  9.0 N·m
-======================  ================================  ========================
+- not at the limit: a finger held against the rail at its torque limit would trip its
+  board within `daemon.board_trip`'s 0.5 s, and a grip that squeezed so hard (8.3 N·m
+  about the rail) does not turn, while the plan turns a held hand on its rail by up to
+  55° as the body rises past it (`planner.output`'s held-palm turn): the arm then folded
+  elsewhere, bent the grip open and the hand dropped the rail (DRC seed 1, 72.0 s);
+- not zero: a hook that does not squeeze holds along an inclined rail only what the
+  load across it presses, and the planned hand forces push along the rail (the planner's
+  hand hold is a push-up and a pull-in contact; on a 60° rail both have a component
+  along it). The DRC mount's holds need up to 65 N of squeeze, 0.78 N·m a finger; with
+  none the hands slid 2–3 cm down the rails and a hip roll's board tripped at 31 s.
 
-``ℓ = 0.06 m`` is the finger-joint-to-rail-axis lever at the grip centre (finger joints
-4.5 cm above and 4 cm beside it: ``√(0.045² + 0.04²)``), ``x_i`` the finger positions
-along the grip axis (±36, ±18, 0 mm), ``μ`` the ladder's friction. The load is the
-weld's constraint wrench on the hand, about the palm site, split along and across the
-rail. ``slip_persistence_s = 10 ms`` (two ticks) only filters single-step constraint
-spikes at impacts; it is not a tuning knob.
+Capacities: the squeeze and the fingers' strength set what the grip holds:
 
-A hand that held by the weld's full stiffness in all six directions would carry whatever
-twist the arm gives it until the latch let go: a compliant arm at a near-singular wrist,
-moved by the body's centimetre of sag, twisted a DRC grip past 8.3 N·m about its rail
-and the hand dropped a rail it was still closed on.
+======================  ====================================  ========================
+load on the hand        capacity                              DRC-Hubo, μ = 0.4
+======================  ====================================  ========================
+radial force            ``N = n·τ_f / ℓ``                     5·5/0.06 = 417 N
+bending torque          ``(τ_f/ℓ)·Σ|x_i|`` (finger couple)      9.0 N·m
+force along the rail    ``μ·(2·S + F_r)``, ``S = n·τ_s / ℓ``  67 N + 0.4·F_r
+torque about the rail   ``μ·(2·S + F_r)·r_rail``              1.7 N·m + 0.01 m·F_r
+======================  ====================================  ========================
+
+``F_r`` is the load across the rail (fingers and palm each press with ``S``, one of them
+also with ``F_r``), ``τ_f`` a finger's torque limit (hubo-facts §5: ≈ 5 N·m), ``τ_s``
+its squeeze, ``ℓ = 0.06 m`` the finger-joint-to-rail-axis lever at the grip centre
+(finger joints 4.5 cm above and 4 cm beside it: ``√(0.045² + 0.04²)``), ``x_i`` the
+finger positions along the grip axis (±36, ±18, 0 mm), ``μ`` the ladder's friction,
+``r_rail`` = 25 mm on the bundled ladders. The load is the weld's constraint wrench on the
+hand, about the palm site, split along and across the rail. ``slip_persistence_s =
+10 ms`` (two ticks) only filters single-step constraint spikes at impacts; it is not a
+tuning knob.
 """
 
 from __future__ import annotations
@@ -90,6 +102,8 @@ class GripConfig:
         position_tolerance_m: palm site to rail axis [m].
         angle_tolerance_rad: grip axis to rail direction [rad].
         finger_torque_nm: torque limit of one finger [N·m].
+        finger_squeeze_nm: torque each closed finger presses the rail with [N·m]
+            (module docstring: why 1).
         finger_lever_m: finger joint to rail axis at the grip centre [m].
         slip_persistence_s: how long an overload must last to release [s].
     """
@@ -99,6 +113,7 @@ class GripConfig:
     position_tolerance_m: float = 0.02
     angle_tolerance_rad: float = math.radians(20.0)
     finger_torque_nm: float = 5.0
+    finger_squeeze_nm: float = 1.0
     finger_lever_m: float = 0.06
     slip_persistence_s: float = 0.01
 
@@ -108,30 +123,49 @@ class GripCapacity:
     """What a closed hand can carry on a rail (module docstring table)."""
 
     radial_n: float
-    axial_n: float
-    roll_nm: float
     bending_nm: float
+    squeeze_n: float
+    friction: float
+    rail_radius_m: float
 
     @classmethod
     def of(cls, cfg: GripConfig, friction: float, rail_radius_m: float,
            finger_torque_nm: float | None = None) -> GripCapacity:
         tau = cfg.finger_torque_nm if finger_torque_nm is None else finger_torque_nm
         per_finger = tau / cfg.finger_lever_m
-        n = per_finger * len(FINGER_X_M)
-        return cls(n, 2 * friction * n, 2 * friction * n * rail_radius_m,
-                   per_finger * sum(abs(x) for x in FINGER_X_M))
+        n = len(FINGER_X_M)
+        return cls(per_finger * n, per_finger * sum(abs(x) for x in FINGER_X_M),
+                   n * cfg.finger_squeeze_nm / cfg.finger_lever_m, friction, rail_radius_m)
+
+    def along_n(self, radial_load_n: float) -> float:
+        """Friction along the rail under a load ``radial_load_n`` across it [N]: the
+        fingers and the palm each press the rail with the squeeze, one of them also with
+        the load."""
+        return self.friction * (2.0 * self.squeeze_n + radial_load_n)
+
+    def about_nm(self, radial_load_n: float) -> float:
+        """Friction torque about the rail under a load ``radial_load_n`` across it [N·m]."""
+        return self.along_n(radial_load_n) * self.rail_radius_m
 
     def utilisation(self, force_n: np.ndarray, torque_nm: np.ndarray,
                     axis: np.ndarray) -> dict[str, float]:
-        """Load / capacity ratio of each component (`SLIP_LOADS` and `RELEASE_LOADS`)."""
+        """Load / capacity ratio of each component (`SLIP_LOADS` and `RELEASE_LOADS`); a
+        load along or about an unloaded rail is infinitely over what friction holds."""
         fa = float(force_n @ axis)
         ta = float(torque_nm @ axis)
+        radial = _norm(force_n - fa * axis)
         return {
-            "radial force": _norm(force_n - fa * axis) / self.radial_n,
-            "force along the rail": abs(fa) / self.axial_n,
-            "torque about the rail": abs(ta) / self.roll_nm,
+            "radial force": radial / self.radial_n,
+            "force along the rail": _ratio(abs(fa), self.along_n(radial)),
+            "torque about the rail": _ratio(abs(ta), self.about_nm(radial)),
             "bending torque": _norm(torque_nm - ta * axis) / self.bending_nm,
         }
+
+
+def _ratio(load: float, capacity: float) -> float:
+    if capacity > 0.0:
+        return load / capacity
+    return math.inf if load > 0.0 else 0.0
 
 
 #: Loads a closed hand gives way to by slipping on its rail (still latched), in the order

@@ -115,8 +115,7 @@ def _load(args):
                          no_filter=args.no_filter, start_line=args.line)
     if not (np.isfinite(args.line_tolerance) and args.line_tolerance > 0):
         raise InputError(f"--line-tolerance {args.line_tolerance}: must be > 0 [rad]")
-    player = TrajectoryPlayer(traj, opts, schedule, sidecar.arm_feedforward if auto else None,
-                              sidecar.hands_holding() if auto else None)
+    player = TrajectoryPlayer(traj, opts, schedule, sidecar.arm_feedforward if auto else None)
     return traj, player, auto
 
 

@@ -35,13 +35,13 @@ reference filter will give the reference (the motor's back-EMF costs duty while 
 moves). `TrajectoryPlayer.feedforward_duty` turns them into hubo-ach's feed-forward duty
 (``pwm_command``) at the battery voltage the caller knows.
 
-Force control of a holding arm. With feed-forward, on lines where the sidecar says a
-hand holds its rail (``holding``) and its arm is in PWM mode, the arm's compliant joints
-are sent in mode COMPLIANT (``f = pos``): the duty is the feed-forward alone, so the arm
-gives the planned share of the load instead of a stiffness pushing it towards a pose
-the rail does not let it reach (a closed chain's load would otherwise follow the
-joints' stiffness, not the plan). The wrist roll cannot switch to PWM, but in mode
-COMPLIANT its position loop follows its encoder, so it does not twist the grip either.
+A holding arm. An arm in PWM mode keeps hubo-ach's law while its hand holds the rail:
+its stiffness towards the reference (kp) plus the feed-forward. It was once sent in mode
+COMPLIANT (``f = pos``) there, the feed-forward alone, so that it would not fight a grip
+that squeezed the rail and could not turn on it. A hand turns on its rail
+(`daemon.grasp_latch`), and an arm without stiffness had nothing to hold it in the pose
+the closed chain leaves free: on the DRC mount the left wrist pitch drifted 0.67 rad and
+the shoulder 0.34 rad off the plan, and the left knee's board tripped at 81.8 s.
 """
 
 from __future__ import annotations
@@ -334,9 +334,6 @@ class TrajectoryPlayer:
         schedule: per-arm mode schedule (``ArmModeSchedule`` or the sidecar's run-length
             mapping); both arms in position mode when None.
         feedforward: the sidecar's arm torques; no feed-forward when None.
-        holding: arm → bool (N,), lines on which its hand holds a rail
-            (`robot.plan_sidecar.PlanSidecar.hands_holding`); with ``feedforward``, those
-            lines are force-controlled (module docstring). None: no line.
 
     Raises:
         PlayerOptionError: a bad trajectory array, or ``start_line`` beyond its end.
@@ -349,7 +346,6 @@ class TrajectoryPlayer:
         options: PlayerOptions | None = None,
         schedule: ArmModeSchedule | Mapping[str, Sequence[tuple[int, int, str]]] | None = None,
         feedforward: ArmFeedforward | None = None,
-        holding: Mapping[str, np.ndarray] | None = None,
     ):
         self.options = options or PlayerOptions()
         traj = np.array(trajectory_rad, dtype=float)
@@ -403,14 +399,6 @@ class TrajectoryPlayer:
                 f"{feedforward.every_lines} need {feedforward.rows_for(n)}")
         self._feedforward = feedforward
         self._ff_cols = None if feedforward is None else joint_indices(feedforward.joints)
-        self._holding = {arm: np.zeros(n, dtype=bool) for arm in ARMS}
-        for arm, lines in (holding or {}).items():
-            lines = np.asarray(lines, dtype=bool)
-            if arm not in ARMS or lines.shape != (n,):
-                raise ModeScheduleError(f"holding[{arm!r}] must be {n} flags of an arm "
-                                        f"({', '.join(ARMS)})")
-            self._holding[arm] = lines
-        self._force_cols = {arm: joint_indices(ARM_JOINTS[arm]) for arm in ARMS}
         self._filtered_rad: np.ndarray | None = None
         self._filter_length = default_filter_config().filter_length
         self._start_row = self.options.start_line - 1
@@ -531,11 +519,10 @@ class TrajectoryPlayer:
         left = bool(self._pwm_by_line["left"][row])
         right = bool(self._pwm_by_line["right"][row])
         comply = self._comply[(left, right)]
-        feedforward, velocity, mode = self._feedforward_tick(ref, row, comply, (left, right),
-                                                             going_to_init)
+        feedforward, velocity = self._feedforward_tick(ref, row, comply, going_to_init)
         return PlayerTick(
             ref_rad=ref,
-            mode=mode,
+            mode=self._mode,
             comply=comply,
             feedforward_nm=feedforward,
             velocity_rad_s=velocity,
@@ -557,23 +544,18 @@ class TrajectoryPlayer:
 
     # ----------------------------------------------------------------- internals
     def _feedforward_tick(self, ref: np.ndarray, row: int, comply: np.ndarray,
-                          pwm: tuple[bool, bool], going_to_init: bool):
-        """(feed-forward [N·m], reference velocity [rad/s], modes) of a tick: zeros and
-        the plain modes without feed-forward (module docstring)."""
+                          going_to_init: bool) -> tuple[np.ndarray, np.ndarray]:
+        """(feed-forward [N·m], reference velocity [rad/s]) of a tick: zeros without
+        feed-forward (module docstring)."""
         feedforward = np.zeros(NUM_JOINTS)
         if self._feedforward is None:
-            return feedforward, np.zeros(NUM_JOINTS), self._mode
+            return feedforward, np.zeros(NUM_JOINTS)
         velocity = self._filter_velocity(ref, going_to_init)
         if going_to_init:
-            return feedforward, velocity, self._mode
+            return feedforward, velocity
         feedforward[self._ff_cols] = self._feedforward_at(row)
         feedforward[~comply] = 0.0
-        mode = self._mode
-        for arm, arm_pwm in zip(ARMS, pwm, strict=True):
-            if arm_pwm and self._holding[arm][row]:
-                mode = mode.copy() if mode is self._mode else mode
-                mode[self._force_cols[arm]] = RefMode.COMPLIANT.value  # an int is cheaper for numpy
-        return feedforward, velocity, mode
+        return feedforward, velocity
 
     def _filter_velocity(self, ref: np.ndarray, going_to_init: bool) -> np.ndarray:
         """Velocity of ``ref`` through the daemon's reference filter [rad/s] (0 while

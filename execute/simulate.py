@@ -152,7 +152,7 @@ def simulate(trajectory_rad: np.ndarray, sidecar: PlanSidecar, ladder: LadderSpe
     rate = int(round(sidecar.rate_hz))
     player = TrajectoryPlayer(trajectory_rad, PlayerOptions(rate_hz=rate,
                                                             compliant_arms=compliant),
-                              schedule, sidecar.arm_feedforward, sidecar.hands_holding())
+                              schedule, sidecar.arm_feedforward)
     controller = JointController(robot=robot)
     gains = opt.gains or default_drc_gains()
     monitor = VerdictMonitor(board, sidecar, T_err, player.time_of_line, opt.verdict)

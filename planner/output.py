@@ -221,8 +221,9 @@ def held_palm_turn_rad(palms: dict[str, np.ndarray], holding: dict[str, np.ndarr
     """How far each held palm has turned since its hand closed on the rail, per line [rad].
 
     The holds fix a palm's position and grip axis only, so a held hand may turn about its
-    rail from line to line; a closed grip resists that with its friction (8.3 N·m on the
-    DRC rails, `daemon.grasp_latch`), which a compliant arm cannot give.
+    rail from line to line, as a hooked hand does (`daemon.grasp_latch`: the turn costs
+    the friction of the load across the rail); a grip that squeezed the rail would resist
+    it with more than a compliant arm gives.
 
     Args:
         palms: arm → (N, 4, 4) palm poses (`palm_poses`).

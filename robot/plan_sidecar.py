@@ -121,11 +121,6 @@ class PlanSidecar:
     joint_order: tuple[str, ...] = JOINT_NAMES
     arm_feedforward: ArmFeedforward | None = None
 
-    def hands_holding(self) -> dict[str, np.ndarray]:
-        """Arm ("left"/"right") → lines on which its hand holds a rail, bool (line_count,)."""
-        return {arm: hand_holding_lines(self.segments, self.line_count, arm)
-                for arm in ("left", "right")}
-
     def segment_at(self, line: int) -> Segment:
         for seg in self.segments:
             if seg.first_line <= line <= seg.last_line:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import sys
 from pathlib import Path
 
@@ -61,13 +62,23 @@ def _hold(run, ticks: int, ref: np.ndarray, extra=None, limp_arm: str | None = N
 
 
 def test_capacity_from_finger_torque():
-    cap = GripCapacity.of(GripConfig(), friction=0.4, rail_radius_m=0.025)
+    cfg = GripConfig()
+    cap = GripCapacity.of(cfg, friction=0.4, rail_radius_m=0.025)
     assert cap.radial_n == pytest.approx(5 * 5.0 / 0.06)
-    assert cap.axial_n == pytest.approx(2 * 0.4 * cap.radial_n)
+    assert cap.squeeze_n == pytest.approx(5 * cfg.finger_squeeze_nm / 0.06)
+    # fingers and palm each press the rail with the squeeze, one of them also with the load
+    assert cap.along_n(100.0) == pytest.approx(0.4 * (2 * cap.squeeze_n + 100.0))
+    assert cap.about_nm(100.0) == pytest.approx(cap.along_n(100.0) * 0.025)
     axis = np.array([0.0, 0.0, 1.0])
     parts = cap.utilisation(np.array([cap.radial_n * 1.5, 0, 0]), np.zeros(3), axis)
     assert parts["radial force"] == pytest.approx(1.5)
     assert max(parts, key=parts.get) == "radial force"
+    # a hook that does not squeeze holds nothing along a rail nothing presses it onto
+    hook = GripCapacity.of(GripConfig(finger_squeeze_nm=0.0), friction=0.4,
+                           rail_radius_m=0.025)
+    along = hook.utilisation(np.array([0.0, 0.0, 10.0]), np.zeros(3), axis)
+    assert along["force along the rail"] == math.inf
+    assert along["torque about the rail"] == 0.0
 
 
 def test_latches_on_the_rail(latched_run):
@@ -171,7 +182,9 @@ def test_a_grip_turns_on_its_rail_and_holds(plan):
     run = simulate(traj, sc, ladder, SimulationOptions(strategy="mixed", record_qpos=False))
     latch = run.board.latches["right"]
     axis = latch._rail_axis(latch.rail)
-    run.board.data.xfrc_applied[latch.body_id, 3:6] = 2.0 * latch.capacity.roll_nm * axis
+    force, _ = latch.grip_load()
+    radial_n = float(np.linalg.norm(force - (force @ axis) * axis))
+    run.board.data.xfrc_applied[latch.body_id, 3:6] = 2.0 * latch.capacity.about_nm(radial_n) * axis
     about_rail = []
 
     def record(_k):

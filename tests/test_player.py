@@ -340,25 +340,17 @@ def test_feedforward_is_off_during_go_to_init_and_velocity_is_the_filtered_refer
     assert not p.step(3.0 + 121 * 8 * TICK_S).velocity_rad_s.any()
 
 
-def test_a_holding_pwm_arm_is_force_controlled_with_feedforward_only():
-    holding = {"left": np.arange(20) >= 7}  # the hand closes on its rail on line 8
-    p = TrajectoryPlayer(_ramp(20), schedule=SCHEDULE, feedforward=_feedforward(20, 4),
-                         holding=holding)
-    modes = {}
-    for n in range(20 * 8):
-        t = p.step(n * TICK_S)
-        modes[t.line_number] = t.mode
-    lsp, lwr, rsp = JOINT_INDEX["LSP"], JOINT_INDEX["LWR"], JOINT_INDEX["RSP"]
-    assert modes[6][lsp] == RefMode.FILTER  # PWM, hand not yet holding: tracks
-    assert modes[8][lsp] == RefMode.COMPLIANT and modes[12][lsp] == RefMode.COMPLIANT
-    assert modes[8][lwr] == RefMode.COMPLIANT  # no PWM, but its reference follows it
-    assert modes[8][rsp] == RefMode.FILTER  # the other arm is in position mode
-    assert modes[13][lsp] == RefMode.FILTER  # position mode again: never COMPLIANT
-    without = TrajectoryPlayer(_ramp(20), schedule=SCHEDULE, holding=holding)
-    assert all((without.step(n * TICK_S).mode == RefMode.FILTER).all()
-               for n in range(20 * 8))  # no feed-forward: every line as hubo-ach
-    with pytest.raises(ModeScheduleError, match="holding"):
-        TrajectoryPlayer(_ramp(20), holding={"left": np.ones(5, bool)})
+def test_a_pwm_arm_with_feedforward_keeps_tracking_its_reference():
+    """hubo-ach's law for a compliant arm, hand on the rail or not: stiffness towards the
+    reference plus the feed-forward. Mode COMPLIANT (f = pos) would leave it the
+    feed-forward alone and no stiffness to hold the pose the closed chain leaves free."""
+    p = TrajectoryPlayer(_ramp(20), schedule=SCHEDULE, feedforward=_feedforward(20, 4))
+    ticks = [p.step(n * TICK_S) for n in range(20 * 8)]
+    lsp = JOINT_INDEX["LSP"]
+    pwm = [t for t in ticks if t.comply[lsp]]
+    assert {t.line_number for t in pwm} == set(range(6, 13))
+    assert any(t.feedforward_nm[lsp] > 0 for t in pwm)
+    assert all((t.mode == RefMode.FILTER).all() for t in ticks)
 
 
 def test_feedforward_must_cover_the_file():
