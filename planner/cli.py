@@ -2,7 +2,8 @@
 
     plan-ladder LADDER [--robot drc-hubo|hubo2plus] [--seed N] [--rate HZ] [-o OUT.traj]
                 [--time-limit S] [--resolution RAD] [--top-rung K] [--samples N]
-                [--dwell S] [--plots DIR] [-v]
+                [--arm-strategy mixed|position] [--max-torque-ratio R] [--dwell S]
+                [--plots DIR] [-v]
 
 LADDER is a bundled ladder (``drc``, ``ship``, ``stair``) or a spec file. A progress
 bar follows the primitives and rungs; a table summarises each primitive at the end.
@@ -53,6 +54,10 @@ def _parser() -> argparse.ArgumentParser:
                    help="how the arms will be driven while their hands hold rails, which sets "
                         "the torque they can carry: mixed = PWM compliance (default), "
                         "position = rigid")
+    p.add_argument("--max-torque-ratio", type=float, default=1.0, metavar="R",
+                   help="largest planned joint torque as a share of its limit (default 1); "
+                        "below 1 leaves a reserve for what open-loop playback does not "
+                        "follow exactly")
     p.add_argument("--dwell", type=float, default=0.5, metavar="S",
                    help="quasi-static hold after each step [s] (default 0.5)")
     p.add_argument("--plots", metavar="DIR", help="write the CoM/support-region plot of "
@@ -69,7 +74,9 @@ def _check_args(args: argparse.Namespace) -> None:
             ("--time-limit", args.time_limit, args.time_limit > 0, "> 0 s"),
             ("--resolution", args.resolution, 0 < args.resolution <= 0.5, "in (0, 0.5] rad"),
             ("--samples", args.samples, args.samples >= 1, "≥ 1"),
-            ("--dwell", args.dwell, args.dwell >= 0, "≥ 0 s")):
+            ("--dwell", args.dwell, args.dwell >= 0, "≥ 0 s"),
+            ("--max-torque-ratio", args.max_torque_ratio, 0 < args.max_torque_ratio <= 1,
+             "in (0, 1]")):
         if not ok:
             raise InputError(f"option {name} is {value:g}; it must be {rule}")
 
@@ -119,7 +126,8 @@ def _plan(args: argparse.Namespace, err) -> int:
     t0 = time.perf_counter()
     spec = load_ladder(args.ladder)
     config = PlannerConfig(samples_per_step=args.samples, resolution_rad=args.resolution,
-                           time_limit_s=args.time_limit, arm_strategy=args.arm_strategy)
+                           time_limit_s=args.time_limit, arm_strategy=args.arm_strategy,
+                           max_torque_ratio=args.max_torque_ratio)
     planner = ClimbPlanner(spec, robot=args.robot, config=config, seed=args.seed)
     top = planner.top_rung() if args.top_rung is None else args.top_rung
     if not 0 <= top < spec.num_rungs:
