@@ -26,6 +26,8 @@ LIMB_END_LINKS = {
 }
 #: Name of the floor in the environment (a half-space at z = 0).
 FLOOR = "floor"
+#: Links that `CollisionModel`'s ``leg_clearance_m`` keeps off the ladder.
+LEG_LINKS = ("L_thigh", "L_shin", "R_thigh", "R_shin")
 
 
 def _shape(g: Geom) -> tuple[coal.CollisionGeometry, np.ndarray]:
@@ -77,7 +79,10 @@ class CollisionModel:
     """Robot + environment geometry, with pairs switched on and off per stance."""
 
     def __init__(self, kin: HuboKinematics,
-                 environment: list[tuple[str, coal.CollisionGeometry, coal.Transform3s]]):
+                 environment: list[tuple[str, coal.CollisionGeometry, coal.Transform3s]],
+                 leg_clearance_m: float = 0.0):
+        """``leg_clearance_m``: thighs and shins count as colliding with the ladder when
+        closer than this [m] (`in_collision`; `report` gives the true distance)."""
         self.kin = kin
         tree = build_tree(kin.params)
         model = kin.model
@@ -127,6 +132,10 @@ class CollisionModel:
                 self.env_pair_index.append((self.robot_link_of[i], name))
         self.n_self_pairs = len(self.self_pairs)
         self.gdata = pin.GeometryData(geom)
+        for k, (link, env) in enumerate(self.env_pair_index):
+            if link in LEG_LINKS and env != FLOOR:
+                self.gdata.collisionRequests[self.n_self_pairs + k].security_margin = \
+                    leg_clearance_m
         self._allowed: frozenset[tuple[str, str]] = frozenset()
 
     def allow(self, contacts: dict[str, str]) -> None:

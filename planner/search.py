@@ -76,6 +76,11 @@ class PlannerConfig:
     max_backtracks: int = 30
     time_limit_s: float = 600.0
     min_margin_m: float = 0.0
+    # Thighs and shins keep this far from the ladder [m]. A leg bearing the robot sags:
+    # its position loops reach their torque limit at 0.02 rad of error
+    # (robot.mjcf.POSITION_SATURATION_ERROR_RAD), 7 mm at a knee 0.33 m from the hip, and
+    # a shin planned 4 mm from the rung above pressed on it with 111 N in MuJoCo.
+    leg_clearance_m: float = 0.01
     arm_strategy: str = DEFAULT_ARM_STRATEGY  # how gripping arms are driven (arm_capacity)
     # Largest planned joint torque / limit. A bound below 1 would leave room for the load
     # a position-controlled leg and a compliant arm really share differing from the LP's
@@ -202,7 +207,8 @@ class ClimbPlanner:
         self.spec = spec
         self.geom = LadderGeometry(spec)
         self.kin = HuboKinematics.load(robot)
-        self.collision = CollisionModel(self.kin, ladder_collision_objects(spec))
+        self.collision = CollisionModel(self.kin, ladder_collision_objects(spec),
+                                        config.leg_clearance_m)
         for side in "LR":  # the IK and the checker both keep the wrists inside this range
             self.kin.wrapper.set_joint_limits(
                 f"{side}WP", *closed_hand_wrist_pitch_range_rad(self.kin, self.collision, side))
