@@ -82,9 +82,11 @@ class PlannerConfig:
     # a shin planned 4 mm from the rung above pressed on it with 111 N in MuJoCo.
     leg_clearance_m: float = 0.01
     arm_strategy: str = DEFAULT_ARM_STRATEGY  # how gripping arms are driven (arm_capacity)
-    # Largest planned joint torque / limit. A bound below 1 would leave room for the load
-    # a position-controlled leg and a compliant arm really share differing from the LP's
-    # optimum; at 0.85 the DRC mount has no solution, so the default is the limit itself.
+    # Largest planned joint torque / limit. A bound below 1 leaves room for the load a
+    # position-controlled leg and a compliant arm really share differing from the LP's
+    # optimum (in MuJoCo the DRC mount's lift-off passes at 0.90, not at 0.93), but the
+    # search for a DRC lift-off under it took 504 s at 0.90 and found none in 600 s at
+    # 0.85, so the default is the limit itself.
     max_torque_ratio: float = 1.0
     # The OMPL fallback (planner.limb_rrt): RRTConnect's budget in collision checks
     # (≈ 0.1 ms each; an arm through a steep ladder's rungs took up to 26,000), tried on
