@@ -65,3 +65,36 @@ def test_planner_and_simulator_measure_the_same_distances_to_the_rungs():
                 assert abs(d_mj - d_coal) < 1e-4, (body, rung, d_mj, d_coal)
             compared += 1
     assert compared > 50
+
+
+def _model_with_box_near(link: str, gap_m: float, leg_clearance_m: float):
+    """A CollisionModel whose only obstacle is a small box ``gap_m`` in front (+x) of
+    ``link``'s capsule in the zero pose lifted off the floor, and that pose."""
+    import coal
+
+    params = robot_params("drc-hubo")
+    model = pin.buildModelFromXML(robot_urdf(params), pin.JointModelFreeFlyer())
+    data = model.createData()
+    robot = SimpleNamespace(model=model, data=data, params=params)
+    q = pin.neutral(model)
+    q[2] = 1.2  # feet off the floor
+    probe = CollisionModel(robot, [])
+    pin.updateGeometryPlacements(model, data, probe.geom, probe.gdata, q)
+    k = next(i for i, g in enumerate(probe.geom.geometryObjects) if g.name == f"{link}/0")
+    front_m = probe.gdata.oMg[k].translation + (probe.geom.geometryObjects[k].geometry.radius,
+                                                0.0, 0.0)
+    half = 0.02
+    box = coal.Box(2 * half, 2 * half, 2 * half)
+    tf = coal.Transform3s(np.eye(3), front_m + (gap_m + half, 0.0, 0.0))
+    return CollisionModel(robot, [("box", box, tf)], leg_clearance_m), q
+
+
+def test_legs_keep_their_clearance_and_other_links_do_not():
+    for link, margin_applies in (("L_shin", True), ("L_thigh", True), ("L_forearm", False)):
+        without, q = _model_with_box_near(link, 0.005, 0.0)
+        with_clearance, _ = _model_with_box_near(link, 0.005, 0.01)
+        assert not without.in_collision(q)
+        assert with_clearance.in_collision(q) is margin_applies, link
+        # the report stays the true distance
+        assert with_clearance.report(q).min_distance_m == without.report(q).min_distance_m
+        assert 0.004 < without.report(q).min_distance_m < 0.006
