@@ -40,8 +40,9 @@ its stiffness towards the reference (kp) plus the feed-forward. It was once sent
 COMPLIANT (``f = pos``) there, the feed-forward alone, so that it would not fight a grip
 that squeezed the rail and could not turn on it. A hand turns on its rail
 (`daemon.grasp_latch`), and an arm without stiffness had nothing to hold it in the pose
-the closed chain leaves free: on the DRC mount the left wrist pitch drifted 0.67 rad and
-the shoulder 0.34 rad off the plan, and the left knee's board tripped at 81.8 s.
+the closed chain leaves free: on a DRC mount planned at 0.85 of the torque limits the left
+wrist pitch drifted 0.67 rad and the shoulder 0.34 rad off the plan, and the left knee's
+board tripped at 81.8 s.
 """
 
 from __future__ import annotations
