@@ -38,8 +38,7 @@ from it that leaves the weld's spring carrying only the capacity. `slip_rad` and
 The fingers close round the rail and press it with ``finger_squeeze_nm`` each, 1 N·m by
 default, a fifth of their limit:
 
-- not at the limit: a finger held against the rail at its torque limit would trip its
-  board within `daemon.board_trip`'s 0.5 s, and a grip that squeezed so hard (8.3 N·m
+- not at the limit: a grip that squeezed with all five fingers at their limit (8.3 N·m
   about the rail) does not turn, while the plan turns a held hand on its rail by up to
   55° as the body rises past it (`planner.output`'s held-palm turn): the arm then folded
   elsewhere, bent the grip open and the hand dropped the rail (DRC seed 1, 72.0 s);
@@ -129,10 +128,8 @@ class GripCapacity:
     rail_radius_m: float
 
     @classmethod
-    def of(cls, cfg: GripConfig, friction: float, rail_radius_m: float,
-           finger_torque_nm: float | None = None) -> GripCapacity:
-        tau = cfg.finger_torque_nm if finger_torque_nm is None else finger_torque_nm
-        per_finger = tau / cfg.finger_lever_m
+    def of(cls, cfg: GripConfig, friction: float, rail_radius_m: float) -> GripCapacity:
+        per_finger = cfg.finger_torque_nm / cfg.finger_lever_m
         n = len(FINGER_X_M)
         return cls(per_finger * n, per_finger * sum(abs(x) for x in FINGER_X_M),
                    n * cfg.finger_squeeze_nm / cfg.finger_lever_m, friction, rail_radius_m)

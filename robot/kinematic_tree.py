@@ -95,11 +95,12 @@ def _box_inertia(mass: float, half: Vec3) -> Vec3:
 
 
 def _limb(name, parent, joint, axis, origin, mass, length, radius, p, *, extra_geoms=(),
-          inset_m=0.0):
-    """A link whose mass is a capsule hanging ``length`` below its joint (zero pose); its
-    collision capsule stops ``inset_m`` short of the far end."""
-    geoms = ((Geom("capsule", (0, 0, 0), (0, 0, -(length - inset_m)), radius),)
-             if length > 0 else ())
+          end_on_far_joint=False):
+    """A link whose mass is a capsule hanging ``length`` below its joint (zero pose); with
+    ``end_on_far_joint`` its collision capsule's far end sphere is centred on the next
+    joint instead of reaching a radius past it."""
+    capsule_m = length - radius if end_on_far_joint else length
+    geoms = ((Geom("capsule", (0, 0, 0), (0, 0, -capsule_m), radius),) if length > 0 else ())
     geoms += tuple(extra_geoms)
     com = (0.0, 0.0, -length / 2)
     inertia = _capsule_inertia(mass, max(length, 2 * radius), radius)
@@ -208,10 +209,10 @@ def _arm(p: RobotParams, side: str) -> tuple[list[Link], list[Frame]]:
               m["SY"], p.upper_arm_m, 0.045, p),
         _limb(f"{side}_elbow", f"{side}_upper_arm", f"{side}EB", (0, 1, 0),
               (0, 0, -p.upper_arm_m), m["EB"], 0.0, 0.04, p),
-        # The forearm's capsule ends in a sphere centred on the wrist pitch axis rather
-        # than 4 cm past it, inside the hand, where a short hand's closed fingers lie.
+        # The forearm's end sphere would otherwise reach 4 cm into the hand, where a short
+        # hand's closed fingers lie.
         _limb(f"{side}_forearm", f"{side}_elbow", f"{side}WY", (0, 0, 1), (0, 0, 0), m["WY"],
-              p.forearm_m, 0.04, p, inset_m=0.04),
+              p.forearm_m, 0.04, p, end_on_far_joint=True),
         _limb(f"{side}_wrist_pitch", f"{side}_forearm", f"{side}WP", (0, 1, 0),
               (0, 0, -p.forearm_m), m["WP"], 0.0, 0.035, p),
     ]
