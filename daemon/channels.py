@@ -19,7 +19,8 @@ Two implementations behind the one interface:
     not pointed at, then publishes it under a seqlock (odd counter while the slot's row
     of stamp and buffer index changes, a few hundred ns). A reader copies the newest
     published buffer and re-checks the counter. A writer preempted or killed mid-copy
-    never hides its previous sample;
+    never hides its previous sample, nor mid-publish: the buffer its last published row
+    named stays intact until the publish ends, so a reader that saw that row reads it;
   - slots are claimed with Linux open-file-description locks (``F_OFD_SETLK``), which the
     kernel drops when a process dies, so a killed writer's slot is free for the next one;
   - a blocked reader sleeps on a futex: a 32-bit generation word in the file that every
@@ -250,7 +251,9 @@ _COUNTER = struct.Struct("<q")
 _ROW_BODY = struct.Struct("<qqqq")  # time_ns, seq, writer_id, buffer (after the counter)
 _ROW_HEAD = struct.Struct("<qq")  # counter, time_ns
 _FLOCK = struct.Struct("hhqqi4x")  # struct flock on Linux x86-64 / aarch64
-_ODD_SPIN = 2000  # reads of an odd counter before the slot is taken as stuck (dead writer)
+#: Reads of an odd counter before the slot is taken as stuck (a dead writer), when the
+#: reader never saw the slot's previous row (otherwise that row's buffer is read at once).
+_ODD_SPIN = 2000
 
 _LIBC = ctypes.CDLL(None, use_errno=True)
 #: syscall() is variadic: the number is passed as a C long, not a promoted int.
@@ -343,6 +346,8 @@ class ShmChannel(Channel):
         self._rslot: int | None = None
         self._generation: ctypes.c_uint32 | None = None  # the futex word, in the mapping
         self._stuck: dict[int, int] = {}  # slot → counter seen odd for too long
+        # slot → (counter, key, buffer) of the last published (even) row seen
+        self._published: dict[int, tuple[int, tuple[int, int, int], int]] = {}
         self._fence = threading.Lock()
         if _SYS_FUTEX is None:
             raise ChannelError(f"shared-memory channels need Linux futexes on x86-64 or "
@@ -442,8 +447,17 @@ class ShmChannel(Channel):
         return t_ns
 
     def _newest(self) -> tuple[int, tuple[int, int, int], int] | None:
-        """(slot, key, counter, buffer) of the newest published slot."""
+        """(slot, key, counter, buffer) of the newest published slot.
+
+        A slot caught mid-publish (odd counter) counts with the row it published last, if
+        this reader saw that row: its buffer is intact until the publish ends
+        (`_read_slot` checks). Spinning on it instead would take a writer the scheduler
+        preempted there for longer than the spin (3 ms on a loaded 2-core machine) for a
+        dead one and hide its sample: the daemon then had no reference for a tick, held
+        it rigid and dropped a PWM arm's compliance.
+        """
         mm = self._mm
+        published = self._published
         for _ in range(_ODD_SPIN):
             table = _TABLE.unpack_from(mm, _TABLE_OFF)
             best = None
@@ -454,12 +468,16 @@ class ShmChannel(Channel):
                 if counter == 0:
                     continue
                 if counter & 1:
-                    if self._stuck.get(i) != counter:
-                        busy = True
-                    continue
-                key = (table[r + 1], table[r + 2], table[r + 3])
-                if best is None or key > best[1]:
-                    best = (i, key, counter, table[r + 4] & 1)
+                    row = published.get(i)
+                    if row is None or row[0] != counter - 1:
+                        if self._stuck.get(i) != counter:
+                            busy = True
+                        continue
+                else:
+                    row = (counter, (table[r + 1], table[r + 2], table[r + 3]), table[r + 4] & 1)
+                    published[i] = row
+                if best is None or row[1] > best[1]:
+                    best = (i, row[1], row[0], row[2])
             if not busy:
                 return best
         for i in range(MAX_WRITERS):  # still odd after the spin: a writer died publishing
@@ -470,10 +488,13 @@ class ShmChannel(Channel):
         return best
 
     def _read_slot(self, i: int, counter: int, buffer: int) -> np.ndarray | None:
-        """Copy the published buffer of slot ``i``; None if the slot moved on meanwhile."""
+        """Copy ``buffer`` of slot ``i``, published at the even ``counter``; None if the
+        writer may have written into it meanwhile. It writes the other buffer and then
+        publishes it (``counter + 1`` while publishing, ``+ 2`` after); only its next write
+        reuses this one."""
         data = _DATA_OFF + (2 * i + buffer) * self._stride
         buf = bytearray(self._mv[data : data + self._size])
-        if _COUNTER.unpack_from(self._mm, _TABLE_OFF + 8 * _ROW_Q * i)[0] != counter:
+        if _COUNTER.unpack_from(self._mm, _TABLE_OFF + 8 * _ROW_Q * i)[0] > counter + 1:
             return None
         return np.ndarray((), self.dtype, buffer=buf)
 

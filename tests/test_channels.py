@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import gc
+import logging
 import multiprocessing as mp
 import os
 import signal
@@ -219,6 +220,29 @@ def test_a_writer_caught_mid_copy_hides_nothing(instance):
     assert float(r.read_latest()["ref"][0]) == 1.0
     w.write(_ref(2.0))
     assert float(r.read_latest()["ref"][39]) == 2.0
+    r.close()
+    w.close()
+
+
+def test_a_writer_preempted_mid_publish_hides_nothing(instance, caplog):
+    """A writer stopped inside its publish (odd counter) for longer than a reader spins is
+    not taken for dead: a reader that saw its previous row reads that row's buffer."""
+    w = ShmChannel("ref", instance)
+    w.write(_ref(1.0))
+    r = ShmChannel("ref", instance)
+    assert float(r.read_latest()["ref"][0]) == 1.0
+    # w.write(_ref(2.0)) stopped mid-publish: the other buffer filled, the counter odd,
+    # the row's buffer index already switched to it, its stamp not yet.
+    buffer = w._buffer ^ 1
+    data = ch._DATA_OFF + buffer * w._stride
+    w._mv[data : data + w._size] = _ref(2.0).tobytes()
+    struct.pack_into("<q", w._mm, w._table_off, w._counter + 1)
+    struct.pack_into("<q", w._mm, w._table_off + 32, buffer)
+    with caplog.at_level(logging.WARNING, logger="daemon.channels"):
+        assert float(r.read_latest()["ref"][0]) == 1.0
+    assert "stuck" not in caplog.text
+    struct.pack_into("<q", w._mm, w._table_off, w._counter + 2)  # the publish ends
+    assert float(r.read_latest()["ref"][0]) == 2.0
     r.close()
     w.close()
 
