@@ -2,7 +2,8 @@
 
     plan-ladder LADDER [--robot drc-hubo|hubo2plus] [--seed N] [--rate HZ] [-o OUT.traj]
                 [--time-limit S] [--resolution RAD] [--top-rung K] [--samples N]
-                [--arm-strategy mixed|position] [--max-torque-ratio R] [--dwell S]
+                [--arm-strategy mixed|position] [--max-torque-ratio R]
+                [--position-torque-share S] [--dwell S]
                 [--plots DIR] [-v]
 
 LADDER is a bundled ladder (``drc``, ``ship``, ``stair``) or a spec file. A progress
@@ -24,6 +25,7 @@ import sys
 import time
 from pathlib import Path
 
+from planner.arm_capacity import DEFAULT_POSITION_TORQUE_SHARE
 from robot.errors import HuboLadderError, InputError
 
 __all__ = ["main"]
@@ -58,6 +60,11 @@ def _parser() -> argparse.ArgumentParser:
                    help="largest planned joint torque as a share of its limit (default 1); "
                         "below 1 leaves a reserve for what open-loop playback does not "
                         "follow exactly")
+    p.add_argument("--position-torque-share", type=float,
+                   default=DEFAULT_POSITION_TORQUE_SHARE, metavar="S",
+                   help="share of its torque limit a joint in position mode may be planned "
+                        "to (default %(default)g): the legs take what the compliant arms "
+                        "do not give")
     p.add_argument("--dwell", type=float, default=0.5, metavar="S",
                    help="quasi-static hold after each step [s] (default 0.5)")
     p.add_argument("--plots", metavar="DIR", help="write the CoM/support-region plot of "
@@ -76,7 +83,9 @@ def _check_args(args: argparse.Namespace) -> None:
             ("--samples", args.samples, args.samples >= 1, "≥ 1"),
             ("--dwell", args.dwell, args.dwell >= 0, "≥ 0 s"),
             ("--max-torque-ratio", args.max_torque_ratio, 0 < args.max_torque_ratio <= 1,
-             "in (0, 1]")):
+             "in (0, 1]"),
+            ("--position-torque-share", args.position_torque_share,
+             0 < args.position_torque_share <= 1, "in (0, 1]")):
         if not ok:
             raise InputError(f"option {name} is {value:g}; it must be {rule}")
 
@@ -127,7 +136,8 @@ def _plan(args: argparse.Namespace, err) -> int:
     spec = load_ladder(args.ladder)
     config = PlannerConfig(samples_per_step=args.samples, resolution_rad=args.resolution,
                            time_limit_s=args.time_limit, arm_strategy=args.arm_strategy,
-                           max_torque_ratio=args.max_torque_ratio)
+                           max_torque_ratio=args.max_torque_ratio,
+                           position_torque_share=args.position_torque_share)
     planner = ClimbPlanner(spec, robot=args.robot, config=config, seed=args.seed)
     top = planner.top_rung() if args.top_rung is None else args.top_rung
     if not 0 <= top < spec.num_rungs:

@@ -64,24 +64,29 @@ class FeasibleSearchStats:
 
 #: Torque descent: evaluations per attempt; it gives up after ``PATIENCE`` candidates in
 #: a row without improvement. Step sizes (standard deviations) of the pelvis target [m],
-#: the posture preferences [rad] and the torso lean [rad]: fixed, large enough to cross
-#: the shallow local minima that the ladder's torque landscape is full of (shrinking
-#: steps stalled at 1.05–1.3× on the DRC mount where these reach 0.8×).
+#: the posture preferences [rad] and the torso's turn (roll, lean towards the ladder,
+#: yaw) [rad]: fixed, large enough to cross the shallow local minima that the ladder's
+#: torque landscape is full of (shrinking steps stalled at 1.05–1.3× on the DRC mount
+#: where these reach 0.8×). Roll and yaw matter when one foot is on a rung and the other
+#: on the floor: turning the hips over the high foot unloads its hip roll and knee. With
+#: the lean alone, descents of the DRC mount's lift-off (legs planned at 0.9 of their
+#: limits) ended at 1.01–1.5× of the bound; with roll and yaw, at 0.88–1.4×.
 TORQUE_DESCENT_EVALUATIONS = 600
 TORQUE_DESCENT_PATIENCE = 150
 TORQUE_DESCENT_PELVIS_STEP_M = 0.04
 TORQUE_DESCENT_POSTURE_STEP_RAD = 0.1
-TORQUE_DESCENT_LEAN_STEP_RAD = 0.05
+TORQUE_DESCENT_TURN_STEP_RAD = np.array([0.05, 0.05, 0.05])  # roll, lean, yaw
 #: The descent stops once the worst torque ratio is this share of the checker's bound; a
 #: pose just under the bound leaves the path to its neighbours no room.
 TORQUE_DESCENT_TARGET_SHARE = 0.9
 
 
-def _pitch(angle_rad: float) -> np.ndarray:
-    """Rotation about y by ``angle_rad``: applied to the ladder-facing torso orientation,
-    a positive angle leans the torso towards the ladder."""
-    c, s = np.cos(angle_rad), np.sin(angle_rad)
-    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+def _turn(roll_lean_yaw_rad: np.ndarray) -> np.ndarray:
+    """Rotation ``Rz(yaw)·Ry(lean)·Rx(roll)``: applied to the ladder-facing torso
+    orientation, a positive lean tilts the torso towards the ladder."""
+    import pinocchio as pin
+
+    return pin.rpy.rpyToMatrix(*(float(a) for a in roll_lean_yaw_rad))
 
 
 def _descend_torque(kin: HuboKinematics, checker: FeasibilityChecker, target: SearchTarget,
@@ -90,11 +95,12 @@ def _descend_torque(kin: HuboKinematics, checker: FeasibilityChecker, target: Se
                     ) -> tuple[np.ndarray | None, Verdict | None]:
     """Local random search that lowers the worst joint-torque ratio below 1.
 
-    It varies the pelvis target, the torso's lean towards the ladder and the preference
-    of every body joint around the best candidate so far. Stepping up onto a rung with
-    compliant arms takes a forward lean (the upper body's weight ahead of the hips
-    unloads the bent knee) and arms that carry their load along their length (a 1.4 N·m
-    wrist pitch): coordinated changes no single joint's preference makes. Returns the
+    It varies the pelvis target, the torso's turn (its lean towards the ladder, its roll
+    and yaw) and the preference of every body joint around the best candidate so far.
+    Stepping up onto a rung with compliant arms takes a forward lean (the upper body's
+    weight ahead of the hips unloads the bent knee) and arms that carry their load along
+    their length (a 1.4 N·m wrist pitch): coordinated changes no single joint's
+    preference makes. Returns the
     first pose at or under `TORQUE_DESCENT_TARGET_SHARE` of the bound, else the best feasible one.
     """
     # Around where the pelvis and joints are, not their targets: a target the holds keep
@@ -103,7 +109,7 @@ def _descend_torque(kin: HuboKinematics, checker: FeasibilityChecker, target: Se
     best_pelvis = q_start[:3].copy()
     best_posture = {name: float(q_start[i]) for name, i in kin.q_index.items()
                     if not name.startswith(FIXED_JOINT_PREFIXES)}
-    best_ratio, best_q, best_lean, best_verdict = ratio, q_start, 0.0, None
+    best_ratio, best_q, best_turn, best_verdict = ratio, q_start, np.zeros(3), None
     last = None
     stale = 0
     for _ in range(TORQUE_DESCENT_EVALUATIONS):
@@ -112,9 +118,9 @@ def _descend_torque(kin: HuboKinematics, checker: FeasibilityChecker, target: Se
         cand_pelvis = best_pelvis + rng.normal(0.0, TORQUE_DESCENT_PELVIS_STEP_M, 3)
         cand_posture = {k: v + rng.normal(0.0, TORQUE_DESCENT_POSTURE_STEP_RAD)
                         for k, v in best_posture.items()}
-        cand_lean = best_lean + rng.normal(0.0, TORQUE_DESCENT_LEAN_STEP_RAD)
+        cand_turn = best_turn + rng.normal(0.0, TORQUE_DESCENT_TURN_STEP_RAD)
         result = solve_ik(kin, best_q, target.support, target.moving, posture_rad=cand_posture,
-                          torso_R=target.torso_R @ _pitch(cand_lean),
+                          torso_R=target.torso_R @ _turn(cand_turn),
                           pelvis_target_m=cand_pelvis,
                           pelvis_weight=max(target.pelvis_weight, 1.0), com_polygon_cw=polygon,
                           preferences=False, config=ik_config)
@@ -127,7 +133,7 @@ def _descend_torque(kin: HuboKinematics, checker: FeasibilityChecker, target: Se
         if not (np.isfinite(verdict.torque_ratio) and verdict.torque_ratio < best_ratio):
             continue
         best_ratio, best_pelvis, best_posture = verdict.torque_ratio, cand_pelvis, cand_posture
-        best_q, best_lean, stale = result.q, cand_lean, 0
+        best_q, best_turn, stale = result.q, cand_turn, 0
         if verdict.ok:
             best_verdict = verdict
             if best_ratio <= TORQUE_DESCENT_TARGET_SHARE * checker.max_torque_ratio:

@@ -17,7 +17,7 @@ import pinocchio as pin
 
 from ladders.geometry import LadderGeometry
 from ladders.spec import LadderSpec
-from planner.arm_capacity import DEFAULT_ARM_STRATEGY
+from planner.arm_capacity import DEFAULT_ARM_STRATEGY, DEFAULT_POSITION_TORQUE_SHARE
 from planner.collision import CollisionModel
 from planner.contacts import Hold, Stance
 from planner.feasible import FeasibleSearchStats, SearchTarget, find_feasible
@@ -82,12 +82,12 @@ class PlannerConfig:
     # a shin planned 4 mm from the rung above pressed on it with 111 N in MuJoCo.
     leg_clearance_m: float = 0.01
     arm_strategy: str = DEFAULT_ARM_STRATEGY  # how gripping arms are driven (arm_capacity)
-    # Largest planned joint torque / limit. A bound below 1 leaves room for the load a
-    # position-controlled leg and a compliant arm really share differing from the LP's
-    # optimum (in MuJoCo the DRC mount's lift-off passes at 0.90, not at 0.93), but the
-    # search for a DRC lift-off under it took 504 s at 0.90 and found none in 600 s at
-    # 0.85, so the default is the limit itself.
+    # Largest planned joint torque / limit, compliant arm joints included (their limit is
+    # their PWM clamp). The reserve the legs need is `position_torque_share`'s.
     max_torque_ratio: float = 1.0
+    # Share of its torque limit a joint in position mode is planned to (arm_capacity's
+    # DEFAULT_POSITION_TORQUE_SHARE says why 0.9).
+    position_torque_share: float = DEFAULT_POSITION_TORQUE_SHARE
     # The OMPL fallback (planner.limb_rrt): RRTConnect's budget in collision checks
     # (≈ 0.1 ms each; an arm through a steep ladder's rungs took up to 26,000), tried on
     # at most this many samples of a step, as a failed search costs the whole budget, and
@@ -215,7 +215,8 @@ class ClimbPlanner:
             self.kin.wrapper.set_joint_limits(
                 f"{side}WP", *closed_hand_wrist_pitch_range_rad(self.kin, self.collision, side))
         self.checker = FeasibilityChecker(self.kin, self.collision, config.min_margin_m,
-                                          config.arm_strategy, config.max_torque_ratio)
+                                          config.arm_strategy, config.max_torque_ratio,
+                                          config.position_torque_share)
         self.config = config
         self.seed = seed
         self.rng = np.random.default_rng(seed)

@@ -54,11 +54,12 @@ class FeasibilityChecker:
 
     def __init__(self, kin: HuboKinematics, collision: CollisionModel,
                  min_margin_m: float = 0.0, arm_strategy: str = DEFAULT_ARM_STRATEGY,
-                 max_torque_ratio: float = 1.0):
+                 max_torque_ratio: float = 1.0, position_torque_share: float = 1.0):
         self.kin = kin
         self.collision = collision
         self.min_margin_m = min_margin_m
         self.max_torque_ratio = max_torque_ratio
+        self.position_torque_share = position_torque_share
         self.arm_strategy = arm_strategy
         self.torque_max = torque_limits_by_joint(kin.params.name)
         self._torque_limits: dict[frozenset, dict[str, float]] = {}
@@ -85,7 +86,8 @@ class FeasibilityChecker:
         sides = gripping_sides(h.limb for h in stance.holds)
         if sides not in self._torque_limits:
             self._torque_limits[sides] = gripping_torque_limits(
-                self.torque_max, sides, self.arm_strategy)
+                self.torque_max, sides, self.arm_strategy,
+                position_share=self.position_torque_share)
         return self._torque_limits[sides]
 
     def check(self, q: np.ndarray, stance: Stance, contacts: dict[str, str]) -> Verdict:

@@ -54,6 +54,19 @@ def test_only_the_gripping_arm_is_limited_and_only_under_mixed():
         gripping_torque_limits(rigid, {"left"}, "limp")
 
 
+def test_position_share_reserves_torque_of_position_joints_only():
+    rigid = torque_limits_by_joint("drc-hubo")
+    cap = compliant_torque_nm()
+    mixed = gripping_torque_limits(rigid, {"left"}, "mixed", position_share=0.9)
+    for name in ("LKN", "RHR", "WST", "LWR") + ARM_JOINTS["right"]:  # position mode
+        assert mixed[name] == pytest.approx(0.9 * rigid[name])
+    for name in ("LSP", "LEB", "LWP"):  # PWM: the clamp is the ceiling, not shared
+        assert mixed[name] == min(rigid[name], cap[name])
+    rigid_arms = gripping_torque_limits(rigid, {"left", "right"}, "position",
+                                        position_share=0.9)
+    assert rigid_arms == pytest.approx({n: 0.9 * t for n, t in rigid.items()})
+
+
 def test_compliant_speed_leaves_the_load_three_quarters_of_the_clamp():
     # Back-EMF damping b = η·gear²·Kt²/R (Ke = Kt in SI): a shoulder RE35 on a 250:1 gear.
     b_shoulder = 0.7 * 250**2 * 0.060**2 / 2.8
@@ -112,7 +125,9 @@ def test_the_planner_loads_a_gripping_arm_only_up_to_its_compliant_capacity(hand
     # A rigid-arm planner would not be bound by those capacities.
     rigid = ClimbPlanner(load_ladder("drc"), seed=1,
                          config=PlannerConfig(arm_strategy="position"))
-    assert rigid.checker.torque_limits(stance)["LSP"] == torque_limits_by_joint()["LSP"]
+    share = rigid.config.position_torque_share  # a rigid arm is in position mode
+    assert rigid.checker.torque_limits(stance)["LSP"] == pytest.approx(
+        share * torque_limits_by_joint()["LSP"])
 
 
 def test_a_stance_that_needs_the_arms_is_refused_when_they_are_compliant(hands_on_rails):
