@@ -50,7 +50,14 @@ def default_config() -> EmulatorConfig:
 
 
 class _BusSim:
-    """The boards of one bus: motor state and the frame handler."""
+    """The boards of one bus: motor state and the frame handler.
+
+    Cost matters: the emulator shares the GIL with the daemon's loop, and a reply that
+    lands after the tick has read the bus counts as a missed reply. So a wake handles
+    every frame already queued after one integration step, encoder counts come from one
+    vectorised conversion per wake, and the per-board and per-frame lookups are built once
+    here.
+    """
 
     def __init__(self, emu: BoardEmulator, bus_no: int, channel: str):
         self.emu = emu
@@ -60,28 +67,47 @@ class _BusSim:
         self.sensors = {
             (s.board, s.kind): s for s in emu.sensors.sensors if s.can == bus_no and s.active
         }
+        # reference frame id → (motor k of the pair, joint, ref_enc, rad_per_count) rows
+        self._ref_rows: dict[int, list[tuple[int, int, int, float]]] = {}
+        for jmc, chans in self.boards.items():
+            for pair in range((len(chans) + 1) // 2):
+                self._ref_rows[cp.REF_BASE + jmc + cp.PAIR_STRIDE * pair] = [
+                    (k, j, emu.joints.joints[j].ref_enc, emu.joints.joints[j].rad_per_count)
+                    for k, j in enumerate(chans[2 * pair : 2 * pair + 2])
+                    if j >= 0
+                ]
+        self._counts: list[int] | None = None  # this wake's encoder counts, made on first use
+        self._idx = emu._bus_joints[bus_no]
         self.last_t = time.monotonic()
         self.thread = threading.Thread(target=self._run, name=f"board-emu-can{bus_no}", daemon=True)
 
     def _run(self) -> None:
         stop = self.emu._stop
         while not stop.is_set():
-            try:
-                msg = self.bus.recv(timeout=0.02)
-            except can.CanError as e:  # pragma: no cover - virtual bus does not fail
-                log.warning("can%d: receive failed: %s", self.bus_no, e)
-                continue
+            msgs = self._receive()
+            replies: list[can.Message] = []
             with self.emu._lock:
                 self._advance()
-                if msg is None:
-                    continue
-                try:
-                    replies = self._handle(msg)
-                except cp.ProtocolError as e:
-                    log.warning("can%d: bad frame %s: %s", self.bus_no, msg, e)
-                    continue
+                self._counts = None
+                for msg in msgs:
+                    try:
+                        replies += self._handle(msg)
+                    except cp.ProtocolError as e:
+                        log.warning("can%d: bad frame %s: %s", self.bus_no, msg, e)
             for r in replies:
                 self.bus.send(r)
+
+    def _receive(self) -> list[can.Message]:
+        """Wait for a frame (at most 20 ms), then take every frame already queued."""
+        msgs: list[can.Message] = []
+        try:
+            msg = self.bus.recv(timeout=0.02)
+            while msg is not None:
+                msgs.append(msg)
+                msg = self.bus.recv(timeout=0.0)
+        except can.CanError as e:  # pragma: no cover - virtual bus does not fail
+            log.warning("can%d: receive failed: %s", self.bus_no, e)
+        return msgs
 
     def _advance(self) -> None:
         """Integrate every motor of this bus up to now."""
@@ -92,18 +118,21 @@ class _BusSim:
             return
         e = self.emu
         cfg = e.config
-        idx = e._bus_joints[self.bus_no]
-        pwm = e._pwm[idx]
-        alpha = 1.0 - math.exp(-dt / cfg.lag_s)
+        idx = self._idx
         pos = e._pos_rad[idx]
-        target = np.where(pwm, pos - e._duty[idx] * cfg.rad_s_per_pct * dt, pos)  # hubo-ach sign
-        target = np.where(pwm, target, pos + (e._ref_rad[idx] - pos) * alpha)
-        e._pos_rad[idx] = target
+        alpha = 1.0 - math.exp(-dt / cfg.lag_s)
+        step = np.where(
+            e._pwm[idx],
+            -e._duty[idx] * cfg.rad_s_per_pct * dt,  # hubo-ach sign
+            (e._ref_rad[idx] - pos) * alpha,
+        )
+        e._pos_rad[idx] = pos + step
 
     def _silent(self, board: int, sensor: bool = False) -> bool:
         return (self.bus_no, sensor, board) in self.emu._silent
 
     def _handle(self, msg: can.Message) -> list[can.Message]:
+        """The replies to one frame."""
         e = self.emu
         fid = msg.arbitration_id
         if fid == cp.CMD_ID:
@@ -112,12 +141,16 @@ class _BusSim:
             if chans is None or self._silent(jmc):
                 return []
             if cmd == cp.CMD_ENC_REQUEST:
-                out = []
-                for pair in range((len(chans) + 1) // 2):
-                    two = [j for j in chans[2 * pair : 2 * pair + 2]]
-                    counts = [int(e.counts_of(j)) if j >= 0 else 0 for j in two]
-                    out.append(cp.encode_enc_reply(jmc, counts, pair))
-                return out
+                if self._counts is None:
+                    self._counts = e.joints.rad_to_enc(e._pos_rad).tolist()
+                counts = self._counts
+                return [
+                    cp.encode_enc_reply(
+                        jmc, [counts[j] if j >= 0 else 0 for j in chans[2 * pair : 2 * pair + 2]],
+                        pair,
+                    )
+                    for pair in range((len(chans) + 1) // 2)
+                ]
             if cmd == cp.CMD_PWM:
                 two = chans[2 * fields["pair"] : 2 * fields["pair"] + 2]
                 for k, j in enumerate(two):
@@ -138,14 +171,11 @@ class _BusSim:
             if self._silent(board, sensor=True):
                 return []
             return self._sensor_reply(board, kind)
-        off = fid - cp.REF_BASE
-        pair, jmc = divmod(off, cp.PAIR_STRIDE)
-        if 0 <= jmc < 0x30 and jmc in self.boards and msg.dlc == 6:
-            _, pair, counts = cp.decode_ref(msg)
-            two = self.boards[jmc][2 * pair : 2 * pair + 2]
-            for k, j in enumerate(two):
-                if j >= 0:
-                    e._ref_rad[j] = e.joints.enc_to_rad(np.array([counts[k]]), np.array([j]))[0]
+        rows = self._ref_rows.get(fid)
+        if rows is not None and msg.dlc == 6:
+            _, _, pair_counts = cp.decode_ref(msg)
+            for k, j, ref_enc, rad_per_count in rows:
+                e._ref_rad[j] = (pair_counts[k] - ref_enc) * rad_per_count  # enc_to_rad, scalar
         return []
 
     def _sensor_reply(self, board: int, kind: int) -> list[can.Message]:
@@ -280,10 +310,6 @@ class BoardEmulator:
         """A joint's emulated position [rad]."""
         with self._lock:
             return float(self._pos_rad[self.joints[name].index])
-
-    def counts_of(self, j: int) -> int:
-        """A joint's encoder count (caller holds the lock or accepts a race)."""
-        return int(self.joints.rad_to_enc(np.array([self._pos_rad[j]]), np.array([j]))[0])
 
     def current_of(self, j: int) -> float:
         """A joint's motor current [A]."""

@@ -43,6 +43,7 @@ from __future__ import annotations
 
 import enum
 import math
+import struct
 from dataclasses import dataclass, field
 
 import can
@@ -171,10 +172,16 @@ def decode_ref(msg: can.Message) -> tuple[int, int, tuple[int, int]]:
     pair, jmc = divmod(off, PAIR_STRIDE)
     if not (0 <= jmc < 0x30 and 0 <= pair < 4) or msg.dlc != 6:
         raise ProtocolError(f"not a reference frame: id {msg.arbitration_id:#x} dlc {msg.dlc}")
-    b = bytes(msg.data)
-    words = np.array([b[0] | b[1] << 8 | b[2] << 16, b[3] | b[4] << 8 | b[5] << 16])
-    c = from_sign_magnitude(words)
-    return jmc, pair, (int(c[0]), int(c[1]))
+    b = msg.data
+    return jmc, pair, (_counts_of_word(b[0] | b[1] << 8 | b[2] << 16),
+                       _counts_of_word(b[3] | b[4] << 8 | b[5] << 16))
+
+
+def _counts_of_word(word: int) -> int:
+    """One 24-bit sign-magnitude word → count: `from_sign_magnitude` for a single frame,
+    where numpy's per-call cost would dominate."""
+    mag = word & MAX_COUNTS
+    return -mag if word & (1 << 23) else mag
 
 
 def encode_enc_request(jmc: int, ch: int = 0) -> can.Message:
@@ -248,7 +255,11 @@ def decode_command(msg: can.Message) -> tuple[int, int, dict]:
 
 def encode_enc_reply(jmc: int, counts: list[int] | tuple[int, ...], pair: int = 0) -> can.Message:
     """Encoder reply: int32 LE per motor (1 or 2) at id 0x60 + jmc (+ 0x100·pair)."""
-    return _msg(ENC_REPLY_BASE + jmc + PAIR_STRIDE * pair, np.asarray(counts, "<i4").tobytes())
+    try:
+        data = struct.pack(f"<{len(counts)}i", *counts)
+    except struct.error as exc:
+        raise ProtocolError(f"encoder counts {counts} out of int32 range") from exc
+    return _msg(ENC_REPLY_BASE + jmc + PAIR_STRIDE * pair, data)
 
 
 def decode_enc_reply(msg: can.Message) -> tuple[int, int, tuple[int, ...]]:
@@ -297,16 +308,21 @@ def decode_sensor_request(msg: can.Message) -> tuple[int, int]:
     return msg.data[0], msg.data[1]
 
 
-def _i16(values: np.ndarray, scale: float, what: str) -> bytes:
-    raw = np.rint(np.asarray(values, float) * scale)
-    if np.any(np.abs(raw) > 32767):
+def _i16(values: tuple[float, ...], scale: float, what: str) -> bytes:
+    """Values × scale, rounded half to even, as int16 LE (±32767; NaN is out of range).
+
+    struct, not numpy: the board emulator packs a few values per frame, where numpy's
+    per-call cost would dominate.
+    """
+    scaled = [float(v) * scale for v in values]
+    if not all(abs(x) < 32767.5 for x in scaled):  # 32767.5 rounds to 32768
         raise ProtocolError(f"{what} out of int16 range: {values}")
-    return raw.astype("<i2").tobytes()
+    return struct.pack(f"<{len(scaled)}h", *(round(x) for x in scaled))
 
 
 def encode_ft_reply(board: int, mx: float, my: float, fz: float) -> can.Message:
     """FT reply at 0x40 + board: mx, my [N·m] in 0.01 N·m, fz [N] in 0.1 N."""
-    data = _i16(np.array([mx, my]), 100.0, "FT moment") + _i16(np.array([fz]), 10.0, "FT force")
+    data = _i16((mx, my), 100.0, "FT moment") + _i16((fz,), 10.0, "FT force")
     return _msg(FT_REPLY_BASE + board, data)
 
 
@@ -319,12 +335,12 @@ def decode_ft_reply(msg: can.Message) -> tuple[int, tuple[float, float, float]]:
 
 def encode_tilt_reply(board: int, acc: tuple[float, float, float]) -> can.Message:
     """Tilt/IMU acceleration reply at 0x50 + board: ax, ay, az [m/s²] in 0.01 m/s²."""
-    return _msg(TILT_REPLY_BASE + board, _i16(np.asarray(acc), 100.0, "acceleration"))
+    return _msg(TILT_REPLY_BASE + board, _i16(acc, 100.0, "acceleration"))
 
 
 def encode_gyro_reply(board: int, rate: tuple[float, float, float]) -> can.Message:
     """IMU gyro reply at 0x58 + board: wx, wy, wz [rad/s] in 0.001 rad/s."""
-    return _msg(GYRO_REPLY_BASE + board, _i16(np.asarray(rate), 1000.0, "angular rate"))
+    return _msg(GYRO_REPLY_BASE + board, _i16(rate, 1000.0, "angular rate"))
 
 
 def decode_imu_reply(msg: can.Message) -> tuple[int, str, tuple[float, float, float]]:
@@ -341,7 +357,7 @@ def encode_power_reply(volts: float, amps: float) -> can.Message:
     v = int(round(volts * 100.0))
     if not 0 <= v <= 0xFFFF:
         raise ProtocolError(f"bus voltage {volts} V out of range")
-    return _msg(POWER_REPLY_ID, np.array([v], "<u2").tobytes() + _i16(np.array([amps]), 100.0, "I"))
+    return _msg(POWER_REPLY_ID, struct.pack("<H", v) + _i16((amps,), 100.0, "I"))
 
 
 def decode_power_reply(msg: can.Message) -> tuple[float, float, float]:
