@@ -216,12 +216,14 @@ def test_can_daemon_plays_the_fixture_over_virtual_buses(plan, tmp_path):
     _check_mode_switches(rec, plan)
     sc = read_sidecar(sidecar_path(plan))
     last = read_trajectory(plan, sc.rate_hz)[-1]
-    # Every board keeps answering. The emulator's threads share the GIL with the loop, so
-    # a reply now and then lands after the tick has read the bus (NO_REPLY for that
-    # cycle, as with a late board on a real bus: 3–7 % of a joint's cycles here, never
-    # more than 2 in a row); a silent board misses every one.
+    # Every board keeps answering. The emulator's threads share the GIL and the host's
+    # cores with the loop, so a reply now and then lands after the tick has read the bus
+    # (NO_REPLY for that cycle, as with a late board on a real bus): 1–22 % of a joint's
+    # cycles here depending on the host's load, a real board answering in ~0.1 ms
+    # whatever it is. A silent board misses every one: the bound tells the two apart
+    # without measuring the host.
     missed = (rec["status"][-NO_REPLY_WINDOW:] & int(StatusFlag.NO_REPLY)) != 0
-    assert missed.mean(axis=0).max() < 0.2
+    assert missed.mean(axis=0).max() < 0.5
     assert _longest_run(missed) <= 10
     rigid = ~rec["comply"][-1].astype(bool)
     # encoders decoded from the emulator's replies follow the encoded references
