@@ -10,6 +10,7 @@ towards the primitive's seed posture.
 from __future__ import annotations
 
 import logging
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -89,13 +90,16 @@ def _axis_target(current: np.ndarray, target: np.ndarray) -> np.ndarray:
 
 def _hold_error(kin: HuboKinematics, limb_frame: str, T_target: np.ndarray,
                 is_hand: bool) -> tuple[float, float]:
+    # Scalar math (the same arithmetic as np.linalg.norm and np.clip): this runs ~30 times
+    # per IK solve, and numpy's per-call overhead was most of its cost.
     T = kin.wrapper.get_T_world_frame(limb_frame)
-    dp = float(np.linalg.norm(T[:3, 3] - T_target[:3, 3]))
+    d = T[:3, 3] - T_target[:3, 3]
+    dp = math.sqrt(float(d @ d))
     if is_hand:  # only the grip axis is constrained
-        c = float(np.clip(T[:3, 0] @ T_target[:3, 0], -1, 1))
+        c = float(T[:3, 0] @ T_target[:3, 0])
     else:
-        c = float(np.clip((np.trace(T[:3, :3].T @ T_target[:3, :3]) - 1) / 2, -1, 1))
-    return dp, float(np.arccos(c))
+        c = float((np.trace(T[:3, :3].T @ T_target[:3, :3]) - 1) / 2)
+    return dp, float(np.arccos(min(max(c, -1.0), 1.0)))
 
 
 def solve_ik(kin: HuboKinematics, q_seed: np.ndarray, support: tuple[Hold, ...],

@@ -516,8 +516,35 @@ class TorqueCheck:
                 f"{self.worst_joint}, {self.torque(self.worst_joint):+.1f} N·m; {loads})")
 
 
+#: `_actuated` per model and limits: (model, result), keyed by the model's id and the
+#: limits' items. The torque LP runs ~13,000 times a rung on a handful of limit tables,
+#: and walking the model's joints took a tenth of its time.
+_ACTUATED: dict[tuple[int, frozenset], tuple[object, tuple]] = {}
+
+
+def _cross_rows(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-wise ``a × b`` of (n, 3) arrays: `np.cross`'s arithmetic without its axis
+    handling, which cost more than the products on the torque LP's few rows."""
+    out = np.empty_like(b)
+    out[:, 0] = a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1]
+    out[:, 1] = a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]
+    out[:, 2] = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+    return out
+
+
 def _actuated(model, torque_max_nm_by_joint: Mapping[str, float]):
-    """Names, velocity indices and limits of the model's actuated (1-dof) joints."""
+    """Names, velocity indices, limits of the model's actuated (1-dof) joints and the
+    model's weight [N] (memoised per model and limits)."""
+    key = (id(model), frozenset(torque_max_nm_by_joint.items()))
+    hit = _ACTUATED.get(key)
+    if hit is not None and hit[0] is model:
+        return hit[1]
+    result = _walk_actuated(model, torque_max_nm_by_joint)
+    _ACTUATED[key] = (model, result)
+    return result
+
+
+def _walk_actuated(model, torque_max_nm_by_joint: Mapping[str, float]):
     names, idx, tmax, missing = [], [], [], []
     for j in range(1, model.njoints):
         if model.joints[j].nv != 1:  # the free flyer
@@ -534,7 +561,12 @@ def _actuated(model, torque_max_nm_by_joint: Mapping[str, float]):
         raise HuboLadderError(
             f"no positive torque limit for joints {missing}; limits given for "
             f"{sorted(torque_max_nm_by_joint)}")
-    return tuple(names), np.array(idx), np.array(tmax)
+    weight_n = float(sum(model.inertias[j].mass for j in range(model.njoints))
+                     * np.linalg.norm(model.gravity.linear))
+    idx_a, tmax_a = np.array(idx), np.array(tmax)
+    idx_a.setflags(write=False)
+    tmax_a.setflags(write=False)
+    return tuple(names), idx_a, tmax_a, weight_n
 
 
 def torque_feasibility(model, data, q: np.ndarray, stance: Stance,
@@ -570,9 +602,7 @@ def torque_feasibility(model, data, q: np.ndarray, stance: Stance,
     import pinocchio as pin
 
     cfg = config or default_config()
-    names, v_idx, tmax = _actuated(model, torque_max_nm_by_joint)
-    weight_n = float(sum(model.inertias[j].mass for j in range(model.njoints))
-                     * np.linalg.norm(model.gravity.linear))
+    names, v_idx, tmax, weight_n = _actuated(model, torque_max_nm_by_joint)
 
     pin.computeJointJacobians(model, data, q)
     pin.updateFramePlacements(model, data)
@@ -595,7 +625,7 @@ def torque_feasibility(model, data, q: np.ndarray, stance: Stance,
                                float(hold.friction), cfg.cone_edges)  # (m, k, 3)
         k = e.shape[1]
         e_flat = e.reshape(-1, 3)
-        wrench = np.vstack([e_flat.T, np.cross(np.repeat(r, k, axis=0), e_flat).T])  # (6, m k)
+        wrench = np.vstack([e_flat.T, _cross_rows(np.repeat(r, k, axis=0), e_flat).T])
         jac = pin.getFrameJacobian(model, data, fid, pin.LOCAL_WORLD_ALIGNED)
         cols.append(jac.T @ wrench)  # (nv, m k), per unit weight
         edges_by_hold.append((hold.limb, e))
