@@ -15,6 +15,7 @@ import logging
 from dataclasses import dataclass
 
 import numpy as np
+import pinocchio as pin
 
 from planner.contacts import Hold, Stance
 from planner.ik import FIXED_JOINT_PREFIXES, IKConfig, solve_ik
@@ -84,8 +85,6 @@ TORQUE_DESCENT_TARGET_SHARE = 0.9
 def _turn(roll_lean_yaw_rad: np.ndarray) -> np.ndarray:
     """Rotation ``Rz(yaw)·Ry(lean)·Rx(roll)``: applied to the ladder-facing torso
     orientation, a positive lean tilts the torso towards the ladder."""
-    import pinocchio as pin
-
     return pin.rpy.rpyToMatrix(*(float(a) for a in roll_lean_yaw_rad))
 
 
@@ -100,8 +99,8 @@ def _descend_torque(kin: HuboKinematics, checker: FeasibilityChecker, target: Se
     Stepping up onto a rung with compliant arms takes a forward lean (the upper body's
     weight ahead of the hips unloads the bent knee) and arms that carry their load along
     their length (a 1.4 N·m wrist pitch): coordinated changes no single joint's
-    preference makes. Returns the
-    first pose at or under `TORQUE_DESCENT_TARGET_SHARE` of the bound, else the best feasible one.
+    preference makes. Returns the first pose at or under `TORQUE_DESCENT_TARGET_SHARE`
+    of the bound, else the best feasible one.
     """
     # Around where the pelvis and joints are, not their targets: a target the holds keep
     # out of reach (e.g. over a foot on the rung while the other is still on the floor)

@@ -174,6 +174,7 @@ def test_a_plan_for_rigid_arms_keeps_them_in_position_mode(plan, tmp_path, monke
     out = write_plan(res, planner, tmp_path / "r.traj", 200.0, q_start=q0, clearance_every=0)
     sc = read_sidecar(out.sidecar_path)
     assert sc.metrics["arm_strategy"] == "position"
+    assert sc.metrics["position_torque_share"] == planner.config.position_torque_share
     assert sc.arm_modes == {arm: [(1, sc.line_count, "position")] for arm in ("left", "right")}
 
 
