@@ -67,16 +67,15 @@ class _BusSim:
         self.sensors = {
             (s.board, s.kind): s for s in emu.sensors.sensors if s.can == bus_no and s.active
         }
-        # reference frame id → (motor k of the pair, joint, ref_enc, rad_per_count) rows
-        self._ref_rows: dict[int, list[tuple[int, int, int, float]]] = {}
+        # reference frame id → (motor k of the pair, joint) rows
+        self._ref_rows: dict[int, list[tuple[int, int]]] = {}
         for jmc, chans in self.boards.items():
             for pair in range((len(chans) + 1) // 2):
                 self._ref_rows[cp.REF_BASE + jmc + cp.PAIR_STRIDE * pair] = [
-                    (k, j, emu.joints.joints[j].ref_enc, emu.joints.joints[j].rad_per_count)
-                    for k, j in enumerate(chans[2 * pair : 2 * pair + 2])
-                    if j >= 0
+                    (k, j) for k, j in enumerate(chans[2 * pair : 2 * pair + 2]) if j >= 0
                 ]
         self._counts: list[int] | None = None  # this wake's encoder counts, made on first use
+        self._refs: dict[int, int] = {}  # joint → count received this wake, not yet applied
         self._idx = emu._bus_joints[bus_no]
         self.last_t = time.monotonic()
         self.thread = threading.Thread(target=self._run, name=f"board-emu-can{bus_no}", daemon=True)
@@ -94,6 +93,7 @@ class _BusSim:
                         replies += self._handle(msg)
                     except cp.ProtocolError as e:
                         log.warning("can%d: bad frame %s: %s", self.bus_no, msg, e)
+                self._apply_refs()
             for r in replies:
                 self.bus.send(r)
 
@@ -163,6 +163,7 @@ class _BusSim:
                 bits = cp.BoardStatus.CONTROL_ON | (cp.BoardStatus.HOMED if e.config.homed else 0)
                 return [cp.encode_status_reply(jmc, [int(bits)] * len(chans))]
             if cmd == cp.CMD_CURRENT_REQUEST:
+                self._apply_refs()  # the current follows the reference error
                 cur = [e.current_of(j) if j >= 0 else 0.0 for j in chans[:4]]
                 return [cp.encode_current_reply(jmc, cur)]
             return []
@@ -174,9 +175,18 @@ class _BusSim:
         rows = self._ref_rows.get(fid)
         if rows is not None and msg.dlc == 6:
             _, _, pair_counts = cp.decode_ref(msg)
-            for k, j, ref_enc, rad_per_count in rows:
-                e._ref_rad[j] = (pair_counts[k] - ref_enc) * rad_per_count  # enc_to_rad, scalar
+            for k, j in rows:
+                self._refs[j] = pair_counts[k]
         return []
+
+    def _apply_refs(self) -> None:
+        """Convert the references received so far this wake in one `enc_to_rad` call (a
+        later frame for a joint has replaced an earlier one, as when applied in turn)."""
+        if self._refs:
+            joints = list(self._refs)
+            self.emu._ref_rad[joints] = self.emu.joints.enc_to_rad(list(self._refs.values()),
+                                                                   joints)
+            self._refs = {}
 
     def _sensor_reply(self, board: int, kind: int) -> list[can.Message]:
         e = self.emu

@@ -149,11 +149,11 @@ def to_sign_magnitude(counts: np.ndarray) -> np.ndarray:
     return (mag | ((c < 0).astype(np.int64) << 23)).astype(np.uint32)
 
 
-def from_sign_magnitude(words: np.ndarray) -> np.ndarray:
-    """24-bit sign-magnitude words → int64 counts (``0x800000`` decodes to 0)."""
-    w = np.asarray(words, dtype=np.int64)
-    mag = w & MAX_COUNTS
-    return np.where(w & (1 << 23), -mag, mag)
+def from_sign_magnitude(word: int) -> int:
+    """One 24-bit sign-magnitude word → count (``0x800000`` decodes to 0). Scalar: a
+    reference frame holds two words, where numpy's per-call cost would dominate."""
+    mag = word & MAX_COUNTS
+    return -mag if word & (1 << 23) else mag
 
 
 # ---------------------------------------------------------------- joint frames
@@ -173,15 +173,8 @@ def decode_ref(msg: can.Message) -> tuple[int, int, tuple[int, int]]:
     if not (0 <= jmc < 0x30 and 0 <= pair < 4) or msg.dlc != 6:
         raise ProtocolError(f"not a reference frame: id {msg.arbitration_id:#x} dlc {msg.dlc}")
     b = msg.data
-    return jmc, pair, (_counts_of_word(b[0] | b[1] << 8 | b[2] << 16),
-                       _counts_of_word(b[3] | b[4] << 8 | b[5] << 16))
-
-
-def _counts_of_word(word: int) -> int:
-    """One 24-bit sign-magnitude word → count: `from_sign_magnitude` for a single frame,
-    where numpy's per-call cost would dominate."""
-    mag = word & MAX_COUNTS
-    return -mag if word & (1 << 23) else mag
+    return jmc, pair, (from_sign_magnitude(b[0] | b[1] << 8 | b[2] << 16),
+                       from_sign_magnitude(b[3] | b[4] << 8 | b[5] << 16))
 
 
 def encode_enc_request(jmc: int, ch: int = 0) -> can.Message:

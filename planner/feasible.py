@@ -76,7 +76,7 @@ TORQUE_DESCENT_EVALUATIONS = 600
 TORQUE_DESCENT_PATIENCE = 150
 TORQUE_DESCENT_PELVIS_STEP_M = 0.04
 TORQUE_DESCENT_POSTURE_STEP_RAD = 0.1
-TORQUE_DESCENT_TURN_STEP_RAD = np.array([0.05, 0.05, 0.05])  # roll, lean, yaw
+TORQUE_DESCENT_TURN_STEP_RAD = (0.05, 0.05, 0.05)  # roll, lean, yaw
 #: The descent stops once the worst torque ratio is this share of the checker's bound; a
 #: pose just under the bound leaves the path to its neighbours no room.
 TORQUE_DESCENT_TARGET_SHARE = 0.9

@@ -97,8 +97,8 @@ def _box_inertia(mass: float, half: Vec3) -> Vec3:
 def _limb(name, parent, joint, axis, origin, mass, length, radius, p, *, extra_geoms=(),
           end_on_far_joint=False):
     """A link whose mass is a capsule hanging ``length`` below its joint (zero pose); with
-    ``end_on_far_joint`` its collision capsule's far end sphere is centred on the next
-    joint instead of reaching a radius past it."""
+    ``end_on_far_joint`` its collision capsule's far end sphere ends on the next joint
+    (centred a radius short of it) instead of reaching a radius past it."""
     capsule_m = length - radius if end_on_far_joint else length
     geoms = ((Geom("capsule", (0, 0, 0), (0, 0, -capsule_m), radius),) if length > 0 else ())
     geoms += tuple(extra_geoms)
