@@ -61,8 +61,9 @@ def ladder_from_sidecar(d: dict, where: str):
         raise InputError(f"{where}: field 'ladder' is not a ladder spec: {exc}") from None
 
 
-def _why(run, metrics) -> str:
-    """A sentence from the physical quantities behind the outcome."""
+def _why(run, metrics, comparison=None) -> str:
+    """A sentence from the physical quantities behind the outcome (and, for a failure,
+    where the simulation had departed from the plan)."""
     v = run.verdict
     te = metrics.tracking_error_rad
     track = (f"tracking error left {te['left']:.4f} rad, right {te['right']:.4f} rad; peak "
@@ -71,11 +72,13 @@ def _why(run, metrics) -> str:
     grips = "; ".join(str(g) for g in run.log.grasps) or "no grip events"
     if v.climbed:
         return f"every final hold in contact ({grips}); {track}"
-    return f"{v.failure.why} [{grips}]; {track}"
+    departed = "" if comparison is None else f"; {comparison.summary()}"
+    return f"{v.failure.why} [{grips}]; {track}{departed}"
 
 
-def result_json(run, metrics, plan_path: str) -> dict:
-    """The result record written by ``--json``."""
+def result_json(run, metrics, plan_path: str, comparison=None) -> dict:
+    """The result record written by ``--json``; ``comparison`` is the run's end against
+    the plan (`execute.plan_compare`), when computed."""
     v = run.verdict
     f = v.failure
     pe = run.options.placement
@@ -85,7 +88,7 @@ def result_json(run, metrics, plan_path: str) -> dict:
         "cause": None if f is None else f.cause,
         "time_s": run.simulated_s if f is None else f.time_s,
         "line": int(run.log.line_index[-1]) + 1 if f is None else f.line,
-        "why": _why(run, metrics),
+        "why": _why(run, metrics, comparison),
         "details": {} if f is None else f.details,
         "final_holds": v.final_holds,
         "strategy": run.options.strategy,
@@ -94,12 +97,14 @@ def result_json(run, metrics, plan_path: str) -> dict:
         "board_trips": [str(t) for t in run.log.trips],
         "grasp_events": [str(g) for g in run.log.grasps],
         "metrics": metrics.to_json(),
+        "plan_vs_sim": None if comparison is None else comparison.to_json(),
     }
 
 
 def _run(args: argparse.Namespace) -> int:
     from daemon.board_model import BoardModelConfig, PlacementError
     from execute.metrics import compute_metrics
+    from execute.plan_compare import compare_with_plan
     from execute.simulate import SimulationOptions, simulate
     from ladders.loader import load_ladder
     from robot.plan_sidecar import read_sidecar, sidecar_path
@@ -124,7 +129,7 @@ def _run(args: argparse.Namespace) -> int:
                              board=board_cfg)
     run = simulate(traj, sidecar, ladder, opts, robot)
     metrics = compute_metrics(run)
-    result = result_json(run, metrics, str(plan))
+    result = result_json(run, metrics, str(plan), compare_with_plan(run, traj, ladder))
     print(f"{result['verdict']}: {result['why']}")
     print(f"simulated {metrics.simulated_s:.2f} s at {metrics.real_time_factor:.1f}× real "
           f"time")

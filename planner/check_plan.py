@@ -33,13 +33,18 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import SimpleNamespace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from robot.errors import HuboLadderError, InputError, TrajectoryFileError
 from robot.plan_sidecar import PlanSidecar, Segment
 
-__all__ = ["CheckResult", "HOLD_TOL_M", "allowed_contacts", "check_plan", "main"]
+if TYPE_CHECKING:
+    from planner.stability import TorqueCheck
+
+__all__ = ["CheckResult", "HOLD_TOL_M", "PlannedLoad", "allowed_contacts", "check_plan", "main",
+           "planned_load"]
 
 log = logging.getLogger(__name__)
 
@@ -256,6 +261,45 @@ def _segment_of_lines(sidecar: PlanSidecar, where: str) -> np.ndarray:
     if len(missing):
         raise InputError(f"{where}: field 'segments' does not cover line {missing[0] + 1}")
     return index
+
+
+@dataclass(frozen=True, eq=False)
+class PlannedLoad:
+    """The plan's account of one line: where the body is and how it carries its weight.
+
+    Attributes:
+        line: the line (1-based).
+        base_pose: (4, 4) world pose of the robot's root link, placed from a held foot.
+        torque: the torque LP on the line's holds (check-plan's limits and contacts):
+            joint torques and the contact forces on each held limb; None when the line
+            has no foot in contact to place the body from.
+    """
+
+    line: int
+    base_pose: np.ndarray | None
+    torque: TorqueCheck | None
+
+
+def planned_load(traj_rad: np.ndarray, sidecar: PlanSidecar, spec, line: int,
+                 robot: str | None = None) -> PlannedLoad:
+    """The configuration and the torque LP of line ``line`` (1-based), as check-plan
+    computes them: what a simulation of the plan is compared against."""
+    from planner.stability import torque_feasibility
+
+    seg_of = _segment_of_lines(sidecar, "plan")
+    si = int(seg_of[line - 1])
+    seg = sidecar.segments[si]
+    v = _Verifier(spec, robot or sidecar.robot, sidecar.metrics.get("arm_strategy",
+                                                                     "position"))
+    q = v.configuration(traj_rad[line - 1], seg)
+    if q is None:
+        return PlannedLoad(line, None, None)
+    stance, _, limits = v.stance(si, seg)
+    torque = torque_feasibility(v.model, v.data, q, stance, limits, v.frame_id)
+    base = np.eye(4)
+    base[:3, :3] = v.pin.Quaternion(q[6], q[3], q[4], q[5]).toRotationMatrix()
+    base[:3, 3] = q[:3]
+    return PlannedLoad(line, base, torque)
 
 
 def check_plan(traj_rad: np.ndarray, sidecar: PlanSidecar, spec, robot: str | None = None,

@@ -100,3 +100,40 @@ def test_plots_written_or_rendering_reported(plan, tmp_path):
         assert "no rendering" in proc.stderr
         pytest.skip("EGL rendering unavailable: " + proc.stderr.strip())
     assert (out / "snapshots.png").stat().st_size > 1000
+
+
+def test_a_failure_is_compared_with_the_plan_at_its_line(results, plan):
+    from ladders.loader import load_ladder
+    from planner.check_plan import planned_load
+    from robot.plan_sidecar import read_sidecar
+    from robot.trajectory_file import read_trajectory
+
+    r = results["pwm"]
+    c = r["plan_vs_sim"]
+    assert c["line"] == r["line"] and c["time_s"] == pytest.approx(r["time_s"], abs=1e-3)
+    assert "against the plan" in r["why"] and c["joints"][0]["joint"] in r["why"]
+    departures = [abs(j["simulated_nm"] - j["planned_nm"]) / j["limit_nm"]
+                  for j in c["joints"]]
+    assert departures == sorted(departures, reverse=True) and departures[0] > 0
+    # the planned side is check-plan's LP at the failure's line
+    sidecar = read_sidecar(sidecar_path(plan))
+    traj = read_trajectory(plan, sidecar.rate_hz, sidecar.robot)
+    lp = planned_load(traj, sidecar, load_ladder("drc"), r["line"]).torque
+    for j in c["joints"]:
+        assert j["planned_nm"] == pytest.approx(lp.torque(j["joint"]), abs=0.01)
+    # limp arms missed the rails: no simulated grip force where the plan has one
+    assert c["hold_forces_n"]["left_hand"]["simulated"] is None
+    assert c["hold_forces_n"]["left_hand"]["planned"][2] > 0
+
+
+def test_plan_and_simulation_carry_the_same_weight(results):
+    # at rest at the end, the holds' vertical forces add up to the robot's weight in the
+    # LP and in MuJoCo, and the body stands where the plan put it
+    from robot.params import robot_params
+
+    weight_n = robot_params("drc-hubo").total_mass_kg * 9.81
+    c = results["mixed"]["plan_vs_sim"]
+    forces = c["hold_forces_n"].values()
+    assert sum(f["planned"][2] for f in forces) == pytest.approx(weight_n, rel=0.005)
+    assert sum(f["simulated"][2] for f in forces) == pytest.approx(weight_n, rel=0.02)
+    assert max(abs(x) for x in c["pelvis_offset_m"]) < 0.01 and c["pelvis_turn_deg"] < 1
