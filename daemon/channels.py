@@ -18,9 +18,13 @@ Two implementations behind the one interface:
   - one slot per writer with two data buffers: the writer fills the buffer readers are
     not pointed at, then publishes it under a seqlock (odd counter while the slot's row
     of stamp and buffer index changes, a few hundred ns). A reader copies the newest
-    published buffer and re-checks the counter. A writer preempted or killed mid-copy
-    never hides its previous sample, nor mid-publish: the buffer its last published row
-    named stays intact until the publish ends, so a reader that saw that row reads it;
+    published buffer and re-checks the counter. The table of counters and rows is read
+    and written as whole aligned int64s (a `memoryview` cast), never with
+    ``struct.pack_into``, which zero-fills its target before writing: a reader that
+    caught a counter at 0 took a buffer being overwritten for a published one. A writer
+    preempted or killed mid-copy never hides its previous sample, nor mid-publish: the
+    buffer its last published row named stays intact until the publish ends, so a
+    reader that saw that row reads it;
   - slots are claimed with Linux open-file-description locks (``F_OFD_SETLK``), which the
     kernel drops when a process dies, so a killed writer's slot is free for the next one;
   - a blocked reader sleeps on a futex: a 32-bit generation word in the file that every
@@ -238,8 +242,7 @@ _LAST_SLOT_OFF = 52  # u8: the writer slot published last
 _WAIT_OFF = 64  # MAX_READERS "waiting" bytes
 _TABLE_OFF = 128  # per writer slot, 8 × i64: counter, time_ns, seq, writer_id, buffer, pad
 _ROW_Q = 8
-_TABLE = struct.Struct(f"<{_ROW_Q * MAX_WRITERS}q")
-_DATA_OFF = _TABLE_OFF + _TABLE.size
+_DATA_OFF = _TABLE_OFF + 8 * _ROW_Q * MAX_WRITERS
 # Lock byte offsets (OFD locks may lie beyond the end of the file).
 _LOCK_INIT = 1 << 20
 _LOCK_PRESENCE = _LOCK_INIT + 1
@@ -247,9 +250,6 @@ _LOCK_WRITER = _LOCK_INIT + 16
 _LOCK_READER = _LOCK_INIT + 64
 _STAMP = struct.Struct("<IQq")  # the struct header: writer_id, seq, time_ns
 _NOBODY_WAITING = bytes(MAX_READERS)
-_COUNTER = struct.Struct("<q")
-_ROW_BODY = struct.Struct("<qqqq")  # time_ns, seq, writer_id, buffer (after the counter)
-_ROW_HEAD = struct.Struct("<qq")  # counter, time_ns
 _FLOCK = struct.Struct("hhqqi4x")  # struct flock on Linux x86-64 / aarch64
 #: Reads of an odd counter before the slot is taken as stuck (a dead writer), when the
 #: reader never saw the slot's previous row (otherwise that row's buffer is read at once).
@@ -389,22 +389,26 @@ class ShmChannel(Channel):
             _ofd_lock(fd, fcntl.F_UNLCK, _LOCK_INIT)
         self._mm = mmap.mmap(fd, total)
         self._mv = memoryview(self._mm)
+        # The writer table as int64s: each item is one aligned 8-byte load or store.
+        # struct.pack_into zero-fills its target before writing the fields, so a reader
+        # could see a counter of 0 mid-store, and struct reads and writes "<q" a byte at
+        # a time; the seqlock needs each counter and row field read and written whole.
+        self._table = self._mv[_TABLE_OFF:_DATA_OFF].cast("q")
         self._generation = ctypes.c_uint32.from_buffer(self._mm, _GENERATION_OFF)
         self._generation_addr = ctypes.addressof(self._generation)
 
     def _claim_writer_slot(self) -> int:
         for i in range(MAX_WRITERS):
             if _ofd_lock(self._fd, fcntl.F_WRLCK, _LOCK_WRITER + i):
-                off = _TABLE_OFF + 8 * _ROW_Q * i
-                (counter,) = _COUNTER.unpack_from(self._mm, off)
+                row, table = _ROW_Q * i, self._table
+                counter = table[row]
                 if counter & 1:  # a writer died while publishing: the row may be torn
                     log.warning("%s: writer slot %d was torn by a dead writer", self.path, i)
-                    _ROW_BODY.pack_into(self._mm, off + 8, 0, 0, 0, 0)
-                    _COUNTER.pack_into(self._mm, off, counter + 1)
-                self._counter, *_, self._buffer = _ROW_HEAD.unpack_from(self._mm, off) + (
-                    _ROW_BODY.unpack_from(self._mm, off + 8)
-                )
-                self._table_off = off
+                    for k in range(1, 5):
+                        table[row + k] = 0
+                    table[row] = counter + 1
+                self._counter, self._buffer = table[row], table[row + 4]
+                self._row = row
                 self._data_off = _DATA_OFF + 2 * i * self._stride
                 self._wslot = i
                 return i
@@ -426,15 +430,16 @@ class ShmChannel(Channel):
         if not (isinstance(sample, np.ndarray) and sample.dtype == self.dtype):
             sample = np.asarray(sample, dtype=self.dtype)
         self._seq += 1
-        mm, off = self._mm, self._table_off
+        mm, table, row = self._mm, self._table, self._row
         buffer = self._buffer ^ 1  # write the buffer readers are not pointed at
         data = self._data_off + buffer * self._stride
         self._mv[data : data + self._size] = sample.tobytes()
         _STAMP.pack_into(mm, data, self.writer_id, self._seq, t_ns)
         counter = self._counter  # we own the slot: no need to read it back
-        _COUNTER.pack_into(mm, off, counter + 1)  # odd: publishing
-        _ROW_BODY.pack_into(mm, off + 8, t_ns, self._seq, self.writer_id, buffer)
-        _COUNTER.pack_into(mm, off, counter + 2)
+        table[row] = counter + 1  # odd: publishing
+        table[row + 1], table[row + 2] = t_ns, self._seq
+        table[row + 3], table[row + 4] = self.writer_id, buffer
+        table[row] = counter + 2
         self._counter, self._buffer = counter + 2, buffer
         mm[_LAST_SLOT_OFF] = self._wslot  # tells a woken reader which slot to copy
         # A store, not an increment: two writers' read-modify-writes could race to the same
@@ -456,10 +461,9 @@ class ShmChannel(Channel):
         dead one and hide its sample: the daemon then had no reference for a tick, held
         it rigid and dropped a PWM arm's compliance.
         """
-        mm = self._mm
         published = self._published
         for _ in range(_ODD_SPIN):
-            table = _TABLE.unpack_from(mm, _TABLE_OFF)
+            table = self._table.tolist()
             best = None
             busy = False
             for i in range(MAX_WRITERS):
@@ -494,7 +498,7 @@ class ShmChannel(Channel):
         reuses this one."""
         data = _DATA_OFF + (2 * i + buffer) * self._stride
         buf = bytearray(self._mv[data : data + self._size])
-        if _COUNTER.unpack_from(self._mm, _TABLE_OFF + 8 * _ROW_Q * i)[0] > counter + 1:
+        if self._table[_ROW_Q * i] > counter + 1:
             return None
         return np.ndarray((), self.dtype, buffer=buf)
 
@@ -533,10 +537,10 @@ class ShmChannel(Channel):
                 # Fast path: the slot published last, the newest one.
                 i = self._mm[_LAST_SLOT_OFF]
                 if i < MAX_WRITERS:
-                    row = _TABLE_OFF + 8 * _ROW_Q * i
-                    counter, t_ns = _ROW_HEAD.unpack_from(self._mm, row)
+                    row, table = _ROW_Q * i, self._table
+                    counter, t_ns = table[row], table[row + 1]
                     if not counter & 1 and t_ns > last_seq:
-                        buffer = _COUNTER.unpack_from(self._mm, row + 32)[0] & 1
+                        buffer = table[row + 4] & 1
                         latest = self._read_slot(i, counter, buffer)
                         if latest is not None:
                             self._mm[_WAIT_OFF + self._rslot] = 0
@@ -550,6 +554,7 @@ class ShmChannel(Channel):
         if self._rslot is not None:
             self._mm[_WAIT_OFF + self._rslot] = 0
         self._generation = None  # a live ctypes view would keep the mapping from closing
+        self._table.release()
         self._mv.release()
         self._mm.close()
         os.close(self._fd)  # drops every OFD lock of this object

@@ -236,12 +236,12 @@ def test_a_writer_preempted_mid_publish_hides_nothing(instance, caplog):
     buffer = w._buffer ^ 1
     data = ch._DATA_OFF + buffer * w._stride
     w._mv[data : data + w._size] = _ref(2.0).tobytes()
-    struct.pack_into("<q", w._mm, w._table_off, w._counter + 1)
-    struct.pack_into("<q", w._mm, w._table_off + 32, buffer)
+    w._table[w._row] = w._counter + 1
+    w._table[w._row + 4] = buffer
     with caplog.at_level(logging.WARNING, logger="daemon.channels"):
         assert float(r.read_latest()["ref"][0]) == 1.0
     assert "stuck" not in caplog.text
-    struct.pack_into("<q", w._mm, w._table_off, w._counter + 2)  # the publish ends
+    w._table[w._row] = w._counter + 2  # the publish ends
     assert float(r.read_latest()["ref"][0]) == 2.0
     r.close()
     w.close()
