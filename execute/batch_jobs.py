@@ -218,6 +218,7 @@ def validate_job(job: ValidateJob, plan_outcome: dict, out_dir: str) -> dict:
     """
     from daemon.board_model import BoardModelConfig, PlacementError
     from execute.metrics import compute_metrics
+    from execute.plan_compare import compare_with_plan
     from execute.simulate import SimulationOptions, simulate
     from execute.validate_cli import result_json
     from robot.plan_sidecar import read_sidecar, sidecar_path
@@ -232,7 +233,8 @@ def validate_job(job: ValidateJob, plan_outcome: dict, out_dir: str) -> dict:
                              board=BoardModelConfig(battery_v=d.battery_v), record_qpos=False)
     run = simulate(traj, sidecar, d.physical_ladder(job.plan.ladder), opts, sidecar.robot)
     metrics = compute_metrics(run)
-    result = result_json(run, metrics, plan_outcome["traj"])
+    result = result_json(run, metrics, plan_outcome["traj"],
+                         compare_with_plan(run, traj, job.plan.ladder))
     climbed = run.verdict.climbed
     return {"outcome": "climbed" if climbed else "failed", "cause": result["cause"],
             "why": result["why"], "simulated_s": metrics.simulated_s,

@@ -133,4 +133,6 @@ def test_real_plan_and_validate_on_the_stair_first_rung(tmp_path, capsys):
             assert r["result"]["placement_error"]["dx_m"] == r["perturbation"]["dx_m"]
             assert r["outcome"] == "climbed" or r["cause"] in causes
             assert r["why"] and r["simulated_s"] > 0
+            # and where the run ended against the plan's own account of that line
+            assert r["result"]["plan_vs_sim"]["line"] == r["result"]["line"]
     assert "stair" in text and "mixed" in text
