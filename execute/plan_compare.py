@@ -5,11 +5,12 @@ had drifted from the plan by then. The plan side is check-plan's own account of 
 (`planner.check_plan.planned_load`): the body placed from a held foot, and the torque
 LP's joint torques and contact forces. The simulation side is the board model's state at
 the end of the run, which is the failure's instant when the run stops on failure (the
-default). Joints are ranked by how far their torque is from the plan's, as a share of
+default), with the joint torques of the tick before (a board that tripped reports
+none). Joints are ranked by how far their torque is from the plan's, as a share of
 their limit: the closed chain of hands and feet is statically indeterminate, so the LP
 picks one load share and the robot's compliance another, and the joints where the two
-part most are usually where the run broke (DRC seed 2: the waist at 24 N·m against
-12.7 planned, 1.3 s after the left hand let go).
+part most are usually where the run broke (DRC seed 1 at 81.1 s: the left hip pitch at
+12 N·m against 35 planned, the left foot pushed sideways with 111 N against 31).
 """
 
 from __future__ import annotations
@@ -124,7 +125,8 @@ def compare_with_plan(run, trajectory_rad: np.ndarray, ladder) -> PlanComparison
     mujoco.mju_quat2Mat(R_sim, d.qpos[3:7])
     R_rel = plan.base_pose[:3, :3].T @ R_sim.reshape(3, 3)
     turn = math.acos(float(np.clip((np.trace(R_rel) - 1.0) / 2.0, -1.0, 1.0)))
-    tau_sim = board.joint_torque()
+    # The tick before the last: a board that tripped on the last one reports no torque.
+    tau_sim = run.log.torque_nm[max(len(run.log.torque_nm) - 2, 0)]
     tmax = joint_limits(board.robot).torque_max_nm
     loads = [JointLoad(n, float(plan.torque.torques_nm[k]),
                        float(tau_sim[JOINT_INDEX[n]]), float(tmax[JOINT_INDEX[n]]))

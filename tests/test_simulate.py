@@ -16,6 +16,7 @@ from make_fixture import cached_reach_fixture  # noqa: E402
 from daemon.board_model import BoardModel, PlacementError  # noqa: E402
 from daemon.joint_control import JointController  # noqa: E402
 from daemon.pwm import default_drc_gains  # noqa: E402
+from execute.plan_compare import compare_with_plan  # noqa: E402
 from execute.simulate import SimulationOptions, simulate  # noqa: E402
 from ladders.loader import BUNDLED_LADDERS, load_ladder  # noqa: E402
 from ladders.spec import LadderSpec  # noqa: E402
@@ -100,6 +101,14 @@ def test_wrist_roll_trip_drops_the_fingers(plan):
     assert released and released[0].hand == "left" and "finger board" in released[0].reason
     assert not run.board.state().active[JOINT_INDEX["LF1"]]
     assert f.time_s > run.board.latches["left"].config.slip_persistence_s
+    # against the plan, the twisted wrist departs most (roll and yaw, both near their
+    # limits), the roll at its limit: the torque of the tick before the trip, not the
+    # unpowered board's zero
+    c = compare_with_plan(run, traj, ladder)
+    top = {j.joint: j for j in c.joints[:2]}
+    assert c.line == f.line and set(top) == {"LWR", "LWY"}
+    assert abs(top["LWR"].simulated_nm) == pytest.approx(top["LWR"].limit_nm, rel=0.02)
+    assert abs(top["LWR"].planned_nm) < 0.5 * top["LWR"].limit_nm
 
 
 def test_placement_error_parsing():
