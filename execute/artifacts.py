@@ -2,6 +2,9 @@
 
 - ``tracking_<arm>.png``: per arm joint, ``pos − ref`` [rad] against time, PWM stretches
   shaded (like thesis Figs. 4.3–4.4). Matplotlib with the Agg backend (no display).
+- ``plan_vs_sim.png``: for the joints whose torque departed most from the plan by the
+  run's end (`execute.plan_compare`), MuJoCo's torque against the plan's torque LP
+  along the run, with the joint's limit: when the two parted.
 - ``snapshots.png``: a strip of frames from the robot's right, following its CoM,
   rendered off-screen by ``mujoco.Renderer`` with ``MUJOCO_GL=egl``.
 - ``*.mp4``: the same camera at 30 fps through imageio-ffmpeg.
@@ -20,8 +23,8 @@ import numpy as np
 from ladders.render import SNAPSHOT_SIZE, RenderingUnavailable, render_states, write_strip
 from robot.joints import ARM_JOINTS, joint_indices
 
-__all__ = ["RenderingUnavailable", "render_frames", "write_snapshot_strip",
-           "write_tracking_plots", "write_video"]
+__all__ = ["RenderingUnavailable", "render_frames", "write_plan_comparison_plot",
+           "write_snapshot_strip", "write_tracking_plots", "write_video"]
 
 VIDEO_SIZE = (640, 480)  # [px]
 VIDEO_FPS = 30
@@ -61,6 +64,44 @@ def write_tracking_plots(run, out_dir: str | os.PathLike) -> list[Path]:
         plt.close(fig)
         paths.append(path)
     return paths
+
+
+def write_plan_comparison_plot(run, comparison, trajectory_rad: np.ndarray, ladder,
+                               path: str | os.PathLike, joints: int = 4) -> Path:
+    """``plan_vs_sim.png``: simulated against planned torque [N·m] vs time for the
+    ``joints`` joints that departed most from the plan (`execute.plan_compare`)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from execute.plan_compare import planned_torque_history
+
+    names = [j.joint for j in comparison.joints[:joints]]
+    limits = {j.joint: j.limit_nm for j in comparison.joints}
+    times, planned = planned_torque_history(run, trajectory_rad, ladder, names)
+    lg = run.log
+    fig, axes = plt.subplots(len(names), 1, sharex=True, figsize=(8, 2.2 * len(names)),
+                             squeeze=False)
+    for ax, name, col in zip(axes[:, 0], names, planned.T, strict=True):
+        ax.plot(lg.time_s, lg.torque_nm[:, joint_indices([name])[0]], lw=0.8,
+                label="MuJoCo")
+        ax.plot(times, col, lw=1.2, ls="--", label="plan (torque LP)")
+        for sign in (1, -1):
+            ax.axhline(sign * limits[name], color="red", lw=0.6, alpha=0.6)
+        ax.set_ylabel(f"{name}\n[N·m]", fontsize=8)
+        ax.tick_params(labelsize=7)
+        ax.grid(alpha=0.3)
+    axes[0, 0].legend(fontsize=7, loc="upper left")
+    axes[0, 0].set_title(f"joint torque, MuJoCo against the plan\n{comparison.summary()}",
+                         fontsize=8)
+    axes[-1, 0].set_xlabel("time [s]")
+    fig.tight_layout()
+    out = Path(path)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(out, dpi=90)
+    plt.close(fig)
+    return out
 
 
 def render_frames(run, times_s, size: tuple[int, int]) -> list[np.ndarray]:

@@ -2,7 +2,7 @@
 
 A failed run says what broke (a board tripped, a grip let go); this says how the physics
 had drifted from the plan by then. The plan side is check-plan's own account of the line
-(`planner.check_plan.planned_load`): the body placed from a held foot, and the torque
+(`planner.check_plan.planned_loads`): the body placed from a held foot, and the torque
 LP's joint torques and contact forces. The simulation side is the board model's state at
 the end of the run, which is the failure's instant when the run stops on failure (the
 default), with the joint torques of the tick before (a board that tripped reports
@@ -25,7 +25,7 @@ import numpy as np
 from robot.joints import JOINT_INDEX
 from robot.limits import joint_limits
 
-__all__ = ["JointLoad", "PlanComparison", "compare_with_plan"]
+__all__ = ["JointLoad", "PlanComparison", "compare_with_plan", "planned_torque_history"]
 
 #: How many joints the comparison lists (the largest departures from the plan).
 JOINTS_LISTED = 6
@@ -113,11 +113,11 @@ def _body_contact_force(model: mujoco.MjModel, data: mujoco.MjData, body: int) -
 def compare_with_plan(run, trajectory_rad: np.ndarray, ladder) -> PlanComparison | None:
     """Compare the end of ``run`` (an `execute.simulate.SimulationRun`) with the plan's
     account of its line; None when the plan places no body there (no foot held)."""
-    from planner.check_plan import planned_load
+    from planner.check_plan import planned_loads
 
     board, sidecar = run.board, run.sidecar
     line = int(run.log.line_index[-1]) + 1
-    plan = planned_load(trajectory_rad, sidecar, ladder, line, board.robot)
+    plan = planned_loads(trajectory_rad, sidecar, ladder, [line], board.robot)[0]
     if plan.torque is None or not plan.torque.equilibrium:
         return None
     m, d = board.model, board.data
@@ -145,3 +145,22 @@ def compare_with_plan(run, trajectory_rad: np.ndarray, ladder) -> PlanComparison
         holds[limb] = (f.sum(axis=0), sim)
     return PlanComparison(line, board.time_s, d.qpos[:3] - plan.base_pose[:3, 3], turn,
                           tuple(loads[:JOINTS_LISTED]), holds, plan.torque.max_ratio)
+
+
+def planned_torque_history(run, trajectory_rad: np.ndarray, ladder, joints: list[str],
+                           every_s: float = 0.5) -> tuple[np.ndarray, np.ndarray]:
+    """The plan's torques of ``joints`` along the run, for plotting against the
+    simulation's: (times [s], torques (k, len(joints)) [N·m]), a line every ``every_s``
+    of the run (NaN where the plan places no body)."""
+    from planner.check_plan import planned_loads
+
+    log = run.log
+    tick_s = float(log.time_s[1] - log.time_s[0]) if len(log.time_s) > 1 else every_s
+    ticks = np.arange(0, len(log.time_s), max(1, round(every_s / tick_s)))
+    lines = [int(log.line_index[k]) + 1 for k in ticks]
+    torques = np.full((len(ticks), len(joints)), np.nan)
+    for row, plan in enumerate(planned_loads(trajectory_rad, run.sidecar, ladder, lines,
+                                             run.board.robot)):
+        if plan.torque is not None and plan.torque.equilibrium:
+            torques[row] = [plan.torque.torque(n) for n in joints]
+    return log.time_s[ticks], torques

@@ -129,7 +129,8 @@ def _run(args: argparse.Namespace) -> int:
                              board=board_cfg)
     run = simulate(traj, sidecar, ladder, opts, robot)
     metrics = compute_metrics(run)
-    result = result_json(run, metrics, str(plan), compare_with_plan(run, traj, ladder))
+    comparison = compare_with_plan(run, traj, ladder)
+    result = result_json(run, metrics, str(plan), comparison)
     print(f"{result['verdict']}: {result['why']}")
     print(f"simulated {metrics.simulated_s:.2f} s at {metrics.real_time_factor:.1f}× real "
           f"time")
@@ -138,6 +139,7 @@ def _run(args: argparse.Namespace) -> int:
     if args.plots or args.video:
         from execute.artifacts import (
             RenderingUnavailable,
+            write_plan_comparison_plot,
             write_snapshot_strip,
             write_tracking_plots,
             write_video,
@@ -146,6 +148,10 @@ def _run(args: argparse.Namespace) -> int:
             if args.plots:
                 for p in write_tracking_plots(run, args.plots):
                     print(f"wrote {p}")
+                if comparison is not None:
+                    path = write_plan_comparison_plot(run, comparison, traj, ladder,
+                                                      Path(args.plots) / "plan_vs_sim.png")
+                    print(f"wrote {path}")
                 print(f"wrote {write_snapshot_strip(run, Path(args.plots) / 'snapshots.png')}")
             if args.video:
                 print(f"wrote {write_video(run, args.video)}")

@@ -44,7 +44,7 @@ if TYPE_CHECKING:
     from planner.stability import TorqueCheck
 
 __all__ = ["CheckResult", "HOLD_TOL_M", "PlannedLoad", "allowed_contacts", "check_plan", "main",
-           "planned_load"]
+           "planned_loads"]
 
 log = logging.getLogger(__name__)
 
@@ -280,26 +280,30 @@ class PlannedLoad:
     torque: TorqueCheck | None
 
 
-def planned_load(traj_rad: np.ndarray, sidecar: PlanSidecar, spec, line: int,
-                 robot: str | None = None) -> PlannedLoad:
-    """The configuration and the torque LP of line ``line`` (1-based), as check-plan
+def planned_loads(traj_rad: np.ndarray, sidecar: PlanSidecar, spec, lines: Sequence[int],
+                  robot: str | None = None) -> list[PlannedLoad]:
+    """The configuration and the torque LP of each of ``lines`` (1-based), as check-plan
     computes them: what a simulation of the plan is compared against."""
     from planner.stability import torque_feasibility
 
     seg_of = _segment_of_lines(sidecar, "plan")
-    si = int(seg_of[line - 1])
-    seg = sidecar.segments[si]
     v = _Verifier(spec, robot or sidecar.robot, sidecar.metrics.get("arm_strategy",
                                                                      "position"))
-    q = v.configuration(traj_rad[line - 1], seg)
-    if q is None:
-        return PlannedLoad(line, None, None)
-    stance, _, limits = v.stance(si, seg)
-    torque = torque_feasibility(v.model, v.data, q, stance, limits, v.frame_id)
-    base = np.eye(4)
-    base[:3, :3] = v.pin.Quaternion(q[6], q[3], q[4], q[5]).toRotationMatrix()
-    base[:3, 3] = q[:3]
-    return PlannedLoad(line, base, torque)
+    out = []
+    for line in lines:
+        si = int(seg_of[line - 1])
+        seg = sidecar.segments[si]
+        q = v.configuration(traj_rad[line - 1], seg)
+        if q is None:
+            out.append(PlannedLoad(line, None, None))
+            continue
+        stance, _, limits = v.stance(si, seg)
+        torque = torque_feasibility(v.model, v.data, q, stance, limits, v.frame_id)
+        base = np.eye(4)
+        base[:3, :3] = v.pin.Quaternion(q[6], q[3], q[4], q[5]).toRotationMatrix()
+        base[:3, 3] = q[:3]
+        out.append(PlannedLoad(line, base, torque))
+    return out
 
 
 def check_plan(traj_rad: np.ndarray, sidecar: PlanSidecar, spec, robot: str | None = None,

@@ -96,6 +96,7 @@ def test_plots_written_or_rendering_reported(plan, tmp_path):
                           capture_output=True, text=True, env=env, timeout=120)
     assert proc.returncode == 0, proc.stderr
     assert (out / "tracking_left.png").stat().st_size > 1000
+    assert (out / "plan_vs_sim.png").stat().st_size > 1000
     if not (out / "snapshots.png").exists():
         assert "no rendering" in proc.stderr
         pytest.skip("EGL rendering unavailable: " + proc.stderr.strip())
@@ -104,7 +105,7 @@ def test_plots_written_or_rendering_reported(plan, tmp_path):
 
 def test_a_failure_is_compared_with_the_plan_at_its_line(results, plan):
     from ladders.loader import load_ladder
-    from planner.check_plan import planned_load
+    from planner.check_plan import planned_loads
     from robot.plan_sidecar import read_sidecar
     from robot.trajectory_file import read_trajectory
 
@@ -118,7 +119,7 @@ def test_a_failure_is_compared_with_the_plan_at_its_line(results, plan):
     # the planned side is check-plan's LP at the failure's line
     sidecar = read_sidecar(sidecar_path(plan))
     traj = read_trajectory(plan, sidecar.rate_hz, sidecar.robot)
-    lp = planned_load(traj, sidecar, load_ladder("drc"), r["line"]).torque
+    lp = planned_loads(traj, sidecar, load_ladder("drc"), [r["line"]])[0].torque
     for j in c["joints"]:
         assert j["planned_nm"] == pytest.approx(lp.torque(j["joint"]), abs=0.01)
     # limp arms missed the rails: no simulated grip force where the plan has one
