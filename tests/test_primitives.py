@@ -7,7 +7,7 @@ import pytest
 
 from ladders.geometry import LadderGeometry
 from ladders.loader import load_ladder
-from planner.holds import make_hold, palm_rotation, rail_point
+from planner.holds import FOOT_COP_MARGIN_M, make_hold, palm_rotation, rail_point
 from primitives import RailSeed, RungSeed, climb_sequence
 from primitives.hold_seeds import FOOT_ALONG_M, MOUNT_ALONG_RAIL_M
 from primitives.library import CLIMB_TORSO_ALONG_M, MOUNT_TORSO_ALONG_M
@@ -36,9 +36,13 @@ def test_foot_holds_rest_on_their_rung(name):
         top = geom.rung_top_point(rung, lateral_m=0.11, along_m=FOOT_ALONG_M)
         np.testing.assert_allclose(hold.T_world_frame[:3, 3], top, atol=1e-12)
         assert np.all(hold.normals[:, 2] == 1.0) and hold.friction == spec.friction
-        # Contact corners lie on the tread, not beyond it.
-        along = geom.to_ladder(hold.points_m)[:, 0] - spec.rung_run_m(rung)
-        assert np.all(np.abs(along) <= spec.rung_depth_m / 2 + 1e-9)
+        # Contact corners lie on the tread, the centre-of-pressure margin inside its
+        # edges and the sole's sides.
+        local = geom.to_ladder(hold.points_m)
+        along = local[:, 0] - spec.rung_run_m(rung)
+        assert np.all(np.abs(along) <= spec.rung_depth_m / 2 - FOOT_COP_MARGIN_M + 1e-9)
+        aside = np.abs(local[:, 1] - geom.to_ladder(hold.T_world_frame[:3, 3])[1])
+        np.testing.assert_allclose(aside, DRC_HUBO.foot_width_m / 2 - FOOT_COP_MARGIN_M)
 
 
 def test_rail_holds_follow_the_ladder_placement():
