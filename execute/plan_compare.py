@@ -22,6 +22,7 @@ from typing import Any
 import mujoco
 import numpy as np
 
+from daemon.board_model import TICK_S
 from robot.joints import JOINT_INDEX
 from robot.limits import joint_limits
 
@@ -155,8 +156,7 @@ def planned_torque_history(run, trajectory_rad: np.ndarray, ladder, joints: list
     from planner.check_plan import planned_loads
 
     log = run.log
-    tick_s = float(log.time_s[1] - log.time_s[0]) if len(log.time_s) > 1 else every_s
-    ticks = np.arange(0, len(log.time_s), max(1, round(every_s / tick_s)))
+    ticks = np.arange(0, len(log.time_s), max(1, round(every_s / TICK_S)))
     lines = [int(log.line_index[k]) + 1 for k in ticks]
     torques = np.full((len(ticks), len(joints)), np.nan)
     for row, plan in enumerate(planned_loads(trajectory_rad, run.sidecar, ladder, lines,

@@ -37,6 +37,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from planner.holds import half_tread_m, sole_contact_points
 from robot.errors import HuboLadderError, InputError, TrajectoryFileError
 from robot.plan_sidecar import PlanSidecar, Segment
 
@@ -52,8 +53,6 @@ log = logging.getLogger(__name__)
 HOLD_TOL_M = 0.01
 #: Slack on joint limits for values written by a float formatter [rad].
 LIMIT_TOL_RAD = 1e-9
-#: A cylinder rung supports a sole along a strip this wide [m].
-CYLINDER_STRIP_M = 0.01
 #: Clearance (a slow distance query) is measured on every this-many-th line.
 CLEARANCE_EVERY_LINES = 20
 CHECKS = ("joint limits", "velocity", "holds", "collision", "stability margin",
@@ -193,16 +192,12 @@ class _Verifier:
             top = self.geom.to_ladder(self.geom.rung_top_centres_m[i])
             d = self.geom.to_ladder(p) - top
             # The sole overlaps the tread: its centre within half a foot of the tread.
-            half_along = self._half_tread() + self.params.foot_length_m / 2
+            half_along = half_tread_m(s) + self.params.foot_length_m / 2
             excess = np.array([max(0.0, abs(d[0]) - half_along),
                                max(0.0, abs(d[1]) - s.rung_width_m / 2), d[2]])
             return float(np.linalg.norm(excess))
         raise InputError(f"hold target {target!r} is not 'floor', 'rung_<i>' or "
                          "'rail_left'/'rail_right'")
-
-    def _half_tread(self) -> float:
-        s = self.spec
-        return s.rung_depth_m / 2 if s.rung_shape == "box" else CYLINDER_STRIP_M / 2
 
     def frame_position(self, limb: str) -> np.ndarray:
         return self.data.oMf[self.frame_id[limb]].translation.copy()
@@ -223,17 +218,19 @@ class _Verifier:
             return Hold(limb, record.target, T, np.vstack([p, p]), np.vstack([up, towards]), mu)
         R = self.sole_rotation(record.target)
         T[:3, :3] = R
-        hl, hw = self.params.foot_length_m / 2, self.params.foot_width_m / 2
+        hl = self.params.foot_length_m / 2
         x0, x1 = -hl, hl
         if record.target.startswith("rung_"):
             top = self.geom.rung_top_centres_m[int(record.target.removeprefix("rung_"))]
             # Tread centre along the sole's x axis, relative to the sole frame.
             c = float(R[:, 0] @ (top - p))
-            x0, x1 = max(-hl, c - self._half_tread()), min(hl, c + self._half_tread())
+            half = half_tread_m(self.spec)
+            x0, x1 = max(-hl, c - half), min(hl, c + half)
             if x1 <= x0:
                 x0 = x1 = float(np.clip(c, -hl, hl))
-        local = np.array([[x1, hw, 0], [x1, -hw, 0], [x0, -hw, 0], [x0, hw, 0]], dtype=float)
-        return Hold(limb, record.target, T, local @ R.T + p, np.tile(up, (4, 1)), mu)
+        # The whole support: check-plan verifies the physics, not the planner's margin.
+        pts = sole_contact_points(self.params, T, (x0, x1), margin_m=0.0)
+        return Hold(limb, record.target, T, pts, np.tile(up, (4, 1)), mu)
 
     def stance(self, seg_index: int, seg: Segment):
         """The stance of a segment, its support region and its joint torque limits [N·m]

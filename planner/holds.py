@@ -13,6 +13,11 @@ from robot.params import RobotParams
 CYLINDER_SUPPORT_STRIP_M = 0.01
 
 
+def half_tread_m(spec) -> float:
+    """Half the depth of a rung's tread that supports a sole [m] (a cylinder's strip)."""
+    return spec.rung_depth_m / 2 if spec.rung_shape == "box" else CYLINDER_SUPPORT_STRIP_M / 2
+
+
 def _pose(R: np.ndarray, p: np.ndarray) -> np.ndarray:
     T = np.eye(4)
     T[:3, :3], T[:3, 3] = R, p
@@ -101,8 +106,7 @@ FOOT_COP_MARGIN_M = 0.02
 
 
 def sole_contact_points(params: RobotParams, T_world_sole: np.ndarray,
-                        x_range_m: tuple[float, float],
-                        margin_m: float = FOOT_COP_MARGIN_M) -> np.ndarray:
+                        x_range_m: tuple[float, float], margin_m: float) -> np.ndarray:
     """Four corners of the sole part between ``x_range_m`` (sole frame x), each side
     ``margin_m`` inwards (along x only where the part is wider than twice that) [m],
     world."""
@@ -135,8 +139,7 @@ def make_hold(seed: HoldSeed, geom: LadderGeometry, params: RobotParams,
         along, lateral = seed.along_m + offset_m[0], seed.lateral_m + offset_m[1]
         p = geom.rung_top_point(seed.rung, lateral_m=lateral, along_m=along)
         T = _pose(geom.R_world_ladder, p)
-        half_tread = (geom.spec.rung_depth_m / 2 if geom.spec.rung_shape == "box"
-                      else CYLINDER_SUPPORT_STRIP_M / 2)
+        half_tread = half_tread_m(geom.spec)
         # The tread spans [-along - half, -along + half] in the sole frame; clip to the sole.
         x0, x1 = max(-hl, -along - half_tread), min(hl, -along + half_tread)
         if x1 <= x0:
