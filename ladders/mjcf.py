@@ -12,6 +12,9 @@ from robot.mjcf import ENV_CONAFFINITY, ENV_CONTYPE
 #: Torsional and rolling friction of ladder contacts (MuJoCo's defaults).
 TORSIONAL_FRICTION = 0.005
 ROLLING_FRICTION = 0.0001
+#: Contact priority of ladder geoms, above the robot's 0 (MuJoCo then takes the ladder's
+#: friction and condim for a rung or rail contact instead of the larger of the two).
+LADDER_CONTACT_PRIORITY = 1
 _RGBA = {"rung": [0.85, 0.55, 0.2, 1.0], "rail": [0.75, 0.75, 0.78, 1.0],
          "stringer": [0.55, 0.45, 0.35, 1.0]}
 
@@ -60,6 +63,9 @@ def add_ladder(mj_spec: mujoco.MjSpec, ladder: LadderSpec | LadderGeometry,
         geom.contype, geom.conaffinity = ENV_CONTYPE, ENV_CONAFFINITY
         geom.condim = 3
         geom.friction = [spec.friction, TORSIONAL_FRICTION, ROLLING_FRICTION]
+        # MuJoCo mixes two geoms' friction by their maximum unless one has the higher
+        # priority; the ladder's μ, which the planner assumed, must govern its contacts.
+        geom.priority = LADDER_CONTACT_PRIORITY
         geom.rgba = _RGBA[solid.name.split("_")[0]]
     site_size = [0.01, 0.0, 0.0]
     for i, p in enumerate(geometry.to_ladder(geometry.rung_top_centres_m)):

@@ -1,5 +1,7 @@
 """The MuJoCo scene of each bundled ladder with the robot standing in front of it."""
 
+import dataclasses
+
 import mujoco
 import numpy as np
 import pytest
@@ -27,3 +29,23 @@ def test_scene_holds_the_robot_standing_for_two_seconds(name):
     tilt = 2 * np.arccos(min(1.0, abs(data.qpos[3])))
     assert tilt < np.radians(1.0)
     assert all(data.warning[i].number == 0 for i in range(len(data.warning)))
+
+
+def test_ladder_contacts_take_the_ladders_friction():
+    """MuJoCo mixes friction by the maximum; the ladder's μ (0.3 here, the robot's geoms
+    have 1.0) must be the one its contacts use, as the planner assumed."""
+    ladder = load_ladder("drc")
+    ladder = dataclasses.replace(ladder, friction=0.3)
+    model = build_scene(ladder).compile()
+    data = mujoco.MjData(model)
+    mujoco.mj_resetDataKeyframe(model, data, 0)
+    mujoco.mj_forward(model, data)
+    data.qpos[0] = data.geom_xpos[model.geom("rung_0").id][0]  # the robot inside the ladder
+    mujoco.mj_forward(model, data)
+    is_ladder = [model.geom(i).name.startswith(("rung", "rail", "stringer"))
+                 for i in range(model.ngeom)]
+    ladder_contacts = [c for c in data.contact[:data.ncon]
+                       if is_ladder[c.geom1] != is_ladder[c.geom2]]
+    assert ladder_contacts
+    for c in ladder_contacts:
+        assert c.friction[0] == pytest.approx(0.3)
