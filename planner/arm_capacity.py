@@ -23,13 +23,15 @@ from types import MappingProxyType
 
 import numpy as np
 
+from planner.contacts import Stance
 from robot.joints import ARM_JOINTS, JOINT_INDEX
 from robot.motors import DEFAULT_BATTERY_V, motor_table
 from robot.pwm_gains import safe_default_gain_table
 
 __all__ = ["ARM_STRATEGIES", "BACK_EMF_SHARE", "DEFAULT_ARM_STRATEGY",
            "DEFAULT_POSITION_TORQUE_SHARE",
-           "arms_comply_while_gripping", "compliant_speed_rad_s", "compliant_torque_nm",
+           "arms_comply_while_gripping", "balance_stance", "compliant_speed_rad_s",
+           "compliant_torque_nm",
            "gripping_sides", "gripping_torque_limits", "gripping_velocity_limits"]
 
 ARM_STRATEGIES = ("mixed", "position")
@@ -60,6 +62,24 @@ def arms_comply_while_gripping(strategy: str) -> bool:
     if strategy not in ARM_STRATEGIES:
         raise ValueError(f"unknown arm strategy {strategy!r}; use one of {ARM_STRATEGIES}")
     return strategy != "position"
+
+
+def balance_stance(stance: Stance, strategy: str = DEFAULT_ARM_STRATEGY) -> Stance:
+    """The holds the CoM's static balance may rely on.
+
+    A hand whose arm is the only compliant one gripping carries load but does not hold
+    the balance: the feet must. One PWM arm is a soft spring (its pull grows by the
+    reference error times kp), too soft against the body tipping about the feet's edge.
+    In MuJoCo, DRC seed 1's plan released the left hand on rung 0 with the CoM 9 mm
+    behind the rung's rear edge and the right hand planned to pull 10 N; the body tipped
+    back 10 cm in 2.4 s while that hand's pull grew from 6 to 33 N, until the grip let
+    go. Two compliant arms (the DRC mount, 15 of 16 seeds) and a rigid arm hold it.
+    """
+    hands = [h for h in stance.holds if h.is_hand]
+    feet = tuple(h for h in stance.holds if not h.is_hand)
+    if len(hands) != 1 or not feet or not arms_comply_while_gripping(strategy):
+        return stance
+    return Stance(feet)
 
 
 @lru_cache(maxsize=16)

@@ -16,8 +16,10 @@ ladder's orientation on a rung, level on the floor), then checks:
   holds, and a moving limb what it leaves in the first half of its segment and what it
   reaches in the second);
 - static stability with the holds in contact: the CoM inside the support region
-  (friction cones, Bretl–Lall) and the joint torques within limits (LP), an arm whose
-  hand holds a rail limited to what the sidecar's arm strategy lets it give.
+  (friction cones, Bretl–Lall) of the holds that may balance it (a lone compliant hand
+  may not, `planner.arm_capacity.balance_stance`) and the joint torques within limits
+  (LP), an arm whose hand holds a rail limited to what the sidecar's arm strategy lets it
+  give.
 
 It prints the worst line of each check and exits 0 when all pass, 1 when one fails,
 2 on bad input (the message names the file and the field or line).
@@ -37,6 +39,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from planner.arm_capacity import balance_stance, gripping_sides, gripping_torque_limits
 from planner.holds import half_tread_m, sole_contact_points
 from robot.errors import HuboLadderError, InputError, TrajectoryFileError
 from robot.plan_sidecar import PlanSidecar, Segment
@@ -237,16 +240,15 @@ class _Verifier:
         (arms whose hands hold a rail driven as the plan's arm strategy drives them; the
         planner's capacity model is robot data), cached."""
         if seg_index not in self._stances:
-            from planner.arm_capacity import gripping_sides, gripping_torque_limits
             from planner.contacts import Stance
             from planner.stability import support_region
 
             stance = Stance(tuple(self.contact_hold(lb, h) for lb, h in sorted(seg.holds.items())))
             limits = gripping_torque_limits(self.torque_max, gripping_sides(seg.holds),
                                             self.arm_strategy)
-            self._stances[seg_index] = (stance, support_region(stance,
-                                                               self.params.total_mass_kg),
-                                        limits)
+            region = support_region(balance_stance(stance, self.arm_strategy),
+                                    self.params.total_mass_kg)
+            self._stances[seg_index] = (stance, region, limits)
         return self._stances[seg_index]
 
 
@@ -421,9 +423,10 @@ def check_plan(traj_rad: np.ndarray, sidecar: PlanSidecar, spec, robot: str | No
             d = clear if not math.isnan(clear) else 0.0
             res["collision"].offer(line, -d + (1.0 if hit else 0.0), d,
                                    f"{label}: {pair or 'in collision'}", hit)
+        balance = balance_stance(v.stance(si, seg)[0], v.arm_strategy).limbs
         res["stability margin"].offer(line, -margin, margin,
                                       f"{label}: CoM margin {margin * 100:.1f} cm in the "
-                                      f"support region of {', '.join(sorted(seg.holds))}",
+                                      f"support region of {', '.join(sorted(balance))}",
                                       margin < 0.0)
         if margin >= 0.0:
             res["torque ratio"].offer(line, ratio_t, ratio_t, f"{label}: worst joint {joint}",

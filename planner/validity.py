@@ -15,6 +15,7 @@ import numpy as np
 
 from planner.arm_capacity import (
     DEFAULT_ARM_STRATEGY,
+    balance_stance,
     gripping_sides,
     gripping_torque_limits,
 )
@@ -76,9 +77,11 @@ class FeasibilityChecker:
                             for h in stance.holds))
 
     def region(self, stance: Stance) -> SupportRegion:
+        """The CoM's support region on the holds that may balance it (`balance_stance`)."""
         key = self.stance_key(stance)
         if key not in self._regions:
-            self._regions[key] = support_region(stance, self.kin.params.total_mass_kg)
+            self._regions[key] = support_region(balance_stance(stance, self.arm_strategy),
+                                                self.kin.params.total_mass_kg)
         return self._regions[key]
 
     def torque_limits(self, stance: Stance) -> dict[str, float]:

@@ -6,6 +6,7 @@ import pytest
 from ladders.loader import load_ladder
 from planner.arm_capacity import (
     BACK_EMF_SHARE,
+    balance_stance,
     compliant_speed_rad_s,
     compliant_torque_nm,
     gripping_torque_limits,
@@ -13,7 +14,7 @@ from planner.arm_capacity import (
 )
 from planner.kinematics import ARM_LIMIT_MARGIN_RAD, HuboKinematics
 from planner.search import ClimbPlanner, PlannerConfig, StepStats
-from planner.stability import torque_feasibility, torque_limits_by_joint
+from planner.stability import support_region, torque_feasibility, torque_limits_by_joint
 from primitives.library import climb_sequence
 from robot.joints import ARM_JOINTS, JOINT_INDEX
 from robot.limits import joint_limits
@@ -141,3 +142,22 @@ def test_a_stance_that_needs_the_arms_is_refused_when_they_are_compliant(hands_o
                                p.checker.torque_limits(one_foot))
     assert mixed.max_ratio > rigid.max_ratio
     assert np.isfinite(rigid.max_ratio)
+
+
+def test_a_lone_compliant_hand_does_not_hold_the_balance(hands_on_rails):
+    p, _, stance = hands_on_rails
+    mass = p.kin.params.total_mass_kg
+    one_hand = type(stance)(tuple(h for h in stance.holds if h.limb != "left_hand"))
+    feet = type(stance)(tuple(h for h in stance.holds if not h.is_hand))
+    assert balance_stance(one_hand, "mixed") == feet
+    assert balance_stance(one_hand, "position") == one_hand  # a rigid arm holds it
+    assert balance_stance(stance, "mixed") == stance  # two compliant arms hold it
+    # The pulling hand extends the region behind the feet; the planner's region for a
+    # lone compliant hand is the feet's, and a CoM that only the hand could hold fails.
+    with_hand, feet_only = support_region(one_hand, mass), support_region(feet, mass)
+    behind = np.array([feet_only.vertices[:, 0].min() - 0.03, feet_only.vertices[:, 1].mean()])
+    assert feet_only.margin(behind) < 0 < with_hand.margin(behind)
+    assert p.checker.region(one_hand).margin(behind) < 0
+    rigid = ClimbPlanner(load_ladder("drc"), seed=1,
+                         config=PlannerConfig(arm_strategy="position"))
+    assert rigid.checker.region(one_hand).margin(behind) > 0

@@ -121,3 +121,27 @@ def test_collision_is_reported(good, tmp_path, capsys):
     assert f"collision fails at line {len(q)}" in err
     assert "floor" in err.split("collision fails")[1].splitlines()[0]
     assert f"stability margin fails at line {len(q)}" in err
+
+
+def test_a_lone_compliant_hand_is_not_counted_on_for_balance():
+    """check-plan's support region of a one-hand stance is the feet's under mixed arms
+    (`planner.arm_capacity.balance_stance`), and reaches behind them with a rigid arm."""
+    from ladders.geometry import LadderGeometry
+    from ladders.loader import load_ladder
+    from planner.check_plan import _Verifier
+
+    spec = load_ladder("drc")
+    p0, p1 = LadderGeometry(spec).rail_axis("right")
+    hand = p0 + (p1 - p0) * (1.0 - p0[2]) / (p1[2] - p0[2])  # the rail 1 m up
+    feet = {"left_foot": HoldRecord("floor", (0.0, 0.0885, 0.0)),
+            "right_foot": HoldRecord("floor", (0.0, -0.0885, 0.0))}
+    one_hand = Segment("moveLHand", "limb", 0, 1, 1,
+                       {**feet, "right_hand": HoldRecord("rail_right", tuple(hand))},
+                       ("left_hand",))
+    on_feet = Segment("dwell", "dwell", 0, 1, 1, feet, ())
+    region = {s: _Verifier(spec, "drc-hubo", s).stance(0, one_hand)[1]
+              for s in ("mixed", "position")}
+    feet_region = _Verifier(spec, "drc-hubo", "mixed").stance(0, on_feet)[1]
+    np.testing.assert_allclose(region["mixed"].vertices, feet_region.vertices)
+    behind = np.array([feet_region.vertices[:, 0].min() - 0.03, 0.0])
+    assert region["mixed"].margin(behind) < 0 < region["position"].margin(behind)
