@@ -21,7 +21,7 @@ $(STAMP): pyproject.toml
 demo: install
 	mkdir -p demo-out
 	$(BIN)/python -m ladders show drc --out demo-out
-	$(BIN)/plan-ladder drc --seed 1 -o demo-out/drc.traj --plots demo-out/stances
+	$(BIN)/plan-ladder drc --seed 6 -o demo-out/drc.traj --plots demo-out/stances
 	$(BIN)/check-plan demo-out/drc.traj --ladder drc --every 10
 	MUJOCO_GL=egl $(BIN)/validate-plan demo-out/drc.traj --strategy mixed \
 		--json demo-out/drc.result.json --plots demo-out/plots; \

@@ -26,7 +26,7 @@ import time
 from pathlib import Path
 
 from planner.arm_capacity import DEFAULT_POSITION_TORQUE_SHARE
-from planner.holds import FOOT_COP_MARGIN_M
+from planner.holds import FOOT_COP_MARGIN_M, FOOT_FRICTION_SHARE
 from robot.errors import HuboLadderError, InputError
 
 __all__ = ["main"]
@@ -69,6 +69,9 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--foot-cop-margin", type=float, default=FOOT_COP_MARGIN_M, metavar="M",
                    help="how far the feet's centre of pressure stays inside each sole's "
                         "support [m] (default %(default)g)")
+    p.add_argument("--foot-friction-share", type=float, default=FOOT_FRICTION_SHARE,
+                   metavar="S", help="share of the ladder's friction coefficient a foot is "
+                                     "planned to use (default %(default)g)")
     p.add_argument("--dwell", type=float, default=0.5, metavar="S",
                    help="quasi-static hold after each step [s] (default 0.5)")
     p.add_argument("--plots", metavar="DIR", help="write the CoM/support-region plot of "
@@ -91,7 +94,9 @@ def _check_args(args: argparse.Namespace) -> None:
             ("--position-torque-share", args.position_torque_share,
              0 < args.position_torque_share <= 1, "in (0, 1]"),
             ("--foot-cop-margin", args.foot_cop_margin, 0 <= args.foot_cop_margin <= 0.04,
-             "in [0, 0.04] m")):
+             "in [0, 0.04] m"),
+            ("--foot-friction-share", args.foot_friction_share,
+             0 < args.foot_friction_share <= 1, "in (0, 1]")):
         if not ok:
             raise InputError(f"option {name} is {value:g}; it must be {rule}")
 
@@ -144,7 +149,8 @@ def _plan(args: argparse.Namespace, err) -> int:
                            time_limit_s=args.time_limit, arm_strategy=args.arm_strategy,
                            max_torque_ratio=args.max_torque_ratio,
                            position_torque_share=args.position_torque_share,
-                           foot_cop_margin_m=args.foot_cop_margin)
+                           foot_cop_margin_m=args.foot_cop_margin,
+                           foot_friction_share=args.foot_friction_share)
     planner = ClimbPlanner(spec, robot=args.robot, config=config, seed=args.seed)
     top = planner.top_rung() if args.top_rung is None else args.top_rung
     if not 0 <= top < spec.num_rungs:

@@ -103,6 +103,16 @@ def shoulder_room_along_m(geom: LadderGeometry, params: RobotParams, rung: int,
 #: (`--top-rung 0`), seeds 1–16, climbed in MuJoCo for 7 of 16 without the margin and
 #: for 15 of 16 with 2 cm (seed 6 lost a grip).
 FOOT_COP_MARGIN_M = 0.02
+#: Share of the ladder's μ the planner lets a foot use. The torque LP's optimum puts a
+#: foot's friction on its cone (0.39–0.40 of μ = 0.4 on DRC seed 1's rung 0), and the
+#: load share the robot's compliance makes is not the LP's: in MuJoCo at the spec's
+#: μ = 0.4 the feet of DRC seed 5's plan slid forward on their rungs a few millimetres
+#: a step, the drift grew to 3 cm by rung 8 and a shin leaned on the rung above; at
+#: μ = 1 the same plan climbed, its feet within 1 cm of their holds. Planning to 3/4
+#: of μ is the usual margin of legged-robot planners, not a tuned figure (the first
+#: value tried); check-plan checks the whole μ. With it, seed 6 of seeds 1–8 climbs the
+#: whole DRC ladder in MuJoCo (none without); the feet still creep, less.
+FOOT_FRICTION_SHARE = 0.75
 
 
 def sole_contact_points(params: RobotParams, T_world_sole: np.ndarray,
@@ -121,20 +131,23 @@ def sole_contact_points(params: RobotParams, T_world_sole: np.ndarray,
 def make_hold(seed: HoldSeed, geom: LadderGeometry, params: RobotParams,
               floor_pose: dict[str, np.ndarray] | None = None, offset_m=(0.0, 0.0),
               shoulder_m: np.ndarray | None = None, grip_style: str = "facing",
-              cop_margin_m: float = FOOT_COP_MARGIN_M) -> Hold:
+              cop_margin_m: float = FOOT_COP_MARGIN_M,
+              friction_share: float = FOOT_FRICTION_SHARE) -> Hold:
     """A concrete hold for a seed, shifted by ``offset_m`` = (along, lateral) in L [m].
 
     A rail hold takes a ``grip_style`` (see `palm_rotation`); the ``shoulder`` style needs
     ``shoulder_m``, the current position of that arm's shoulder [m]. A foot hold's
-    contact corners keep its centre of pressure ``cop_margin_m`` inside the support.
+    contact corners keep its centre of pressure ``cop_margin_m`` inside the support, and
+    its friction is ``friction_share`` of the ladder's μ.
     """
     mu = geom.spec.friction
+    foot_mu = mu * friction_share
     up = np.array([0.0, 0.0, 1.0])
     hl = params.foot_length_m / 2
     if isinstance(seed, FloorSeed):
         T = floor_pose[seed.limb]
         pts = sole_contact_points(params, T, (-hl, hl), cop_margin_m)
-        return Hold(seed.limb, "floor", T, pts, np.tile(up, (4, 1)), mu)
+        return Hold(seed.limb, "floor", T, pts, np.tile(up, (4, 1)), foot_mu)
     if isinstance(seed, RungSeed):
         along, lateral = seed.along_m + offset_m[0], seed.lateral_m + offset_m[1]
         p = geom.rung_top_point(seed.rung, lateral_m=lateral, along_m=along)
@@ -145,7 +158,7 @@ def make_hold(seed: HoldSeed, geom: LadderGeometry, params: RobotParams,
         if x1 <= x0:
             raise ValueError(f"the sole does not overlap rung {seed.rung} at offset {along} m")
         pts = sole_contact_points(params, T, (x0, x1), cop_margin_m)
-        return Hold(seed.limb, seed.target, T, pts, np.tile(up, (4, 1)), mu)
+        return Hold(seed.limb, seed.target, T, pts, np.tile(up, (4, 1)), foot_mu)
     if isinstance(seed, RailSeed):
         along = seed.along_m
         if seed.torso_along_m is not None:

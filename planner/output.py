@@ -423,6 +423,7 @@ def write_plan(result: SearchResult, planner: ClimbPlanner, out_traj: str | os.P
     metrics["arm_strategy"] = planner.config.arm_strategy
     metrics["position_torque_share"] = planner.config.position_torque_share
     metrics["foot_cop_margin_m"] = planner.config.foot_cop_margin_m
+    metrics["foot_friction_share"] = planner.config.foot_friction_share
     out_traj = Path(out_traj)
     write_trajectory(out_traj, timed.columns_rad)
     all_timings = dict(timings or {})

@@ -21,7 +21,7 @@ from planner.arm_capacity import DEFAULT_ARM_STRATEGY, DEFAULT_POSITION_TORQUE_S
 from planner.collision import CollisionModel
 from planner.contacts import Hold, Stance
 from planner.feasible import FeasibleSearchStats, SearchTarget, find_feasible
-from planner.holds import FOOT_COP_MARGIN_M, GRIP_STYLES, make_hold
+from planner.holds import FOOT_COP_MARGIN_M, FOOT_FRICTION_SHARE, GRIP_STYLES, make_hold
 from planner.ik import IKConfig, solve_ik
 from planner.interpolation import (
     InterpolationError,
@@ -91,6 +91,8 @@ class PlannerConfig:
     # The feet's centre of pressure stays this far inside each sole's support [m]
     # (planner.holds.FOOT_COP_MARGIN_M says why 2 cm).
     foot_cop_margin_m: float = FOOT_COP_MARGIN_M
+    # Share of the ladder's μ a foot is planned to (planner.holds.FOOT_FRICTION_SHARE).
+    foot_friction_share: float = FOOT_FRICTION_SHARE
     # The OMPL fallback (planner.limb_rrt): RRTConnect's budget in collision checks
     # (≈ 0.1 ms each; an arm through a steep ladder's rungs took up to 26,000), tried on
     # at most this many samples of a step, as a failed search costs the whole budget, and
@@ -275,7 +277,9 @@ class ClimbPlanner:
             T[:3, 3] = kin.frame_pose(q, frame)[:3, 3] * [1, 1, 0]
             floor[limb] = T
         holds = tuple(make_hold(FloorSeed(limb), self.geom, kin.params, floor,
-                                cop_margin_m=self.config.foot_cop_margin_m) for limb in floor)
+                                cop_margin_m=self.config.foot_cop_margin_m,
+                                friction_share=self.config.foot_friction_share)
+                      for limb in floor)
         return self._project(q, holds), Stance(holds)
 
     def _project(self, q: np.ndarray, holds: tuple[Hold, ...]) -> np.ndarray:
@@ -329,7 +333,8 @@ class ClimbPlanner:
         style = GRIP_STYLES[(first + attempt) % len(GRIP_STYLES)]
         return make_hold(seed, self.geom, self.kin.params, offset_m=(along, lateral),
                          shoulder_m=shoulder, grip_style=style,
-                         cop_margin_m=self.config.foot_cop_margin_m)
+                         cop_margin_m=self.config.foot_cop_margin_m,
+                         friction_share=self.config.foot_friction_share)
 
     def _pelvis_target(self, step: Step, support) -> np.ndarray:
         """Seed pelvis position: the primitive's offset from the supporting feet."""

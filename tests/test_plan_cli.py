@@ -48,6 +48,8 @@ def test_bad_spec_exits_2_naming_the_field(tmp_path, capsys):
     (["drc", "--position-torque-share", "0"],
      "--position-torque-share is 0; it must be in (0, 1]"),
     (["drc", "--foot-cop-margin", "0.05"], "--foot-cop-margin is 0.05; it must be in [0, 0.04]"),
+    (["drc", "--foot-friction-share", "1.2"],
+     "--foot-friction-share is 1.2; it must be in (0, 1]"),
     (["drc", "--robot", "asimo"], "invalid choice"),
 ])
 def test_bad_options_exit_2(argv, words, capsys):

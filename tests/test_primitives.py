@@ -7,7 +7,13 @@ import pytest
 
 from ladders.geometry import LadderGeometry
 from ladders.loader import load_ladder
-from planner.holds import FOOT_COP_MARGIN_M, make_hold, palm_rotation, rail_point
+from planner.holds import (
+    FOOT_COP_MARGIN_M,
+    FOOT_FRICTION_SHARE,
+    make_hold,
+    palm_rotation,
+    rail_point,
+)
 from primitives import RailSeed, RungSeed, climb_sequence
 from primitives.hold_seeds import FOOT_ALONG_M, MOUNT_ALONG_RAIL_M
 from primitives.library import CLIMB_TORSO_ALONG_M, MOUNT_TORSO_ALONG_M
@@ -35,7 +41,12 @@ def test_foot_holds_rest_on_their_rung(name):
         hold = make_hold(RungSeed("left_foot", rung, 0.11), geom, DRC_HUBO)
         top = geom.rung_top_point(rung, lateral_m=0.11, along_m=FOOT_ALONG_M)
         np.testing.assert_allclose(hold.T_world_frame[:3, 3], top, atol=1e-12)
-        assert np.all(hold.normals[:, 2] == 1.0) and hold.friction == spec.friction
+        # A foot is planned to a share of the ladder's friction.
+        assert np.all(hold.normals[:, 2] == 1.0)
+        assert hold.friction == pytest.approx(FOOT_FRICTION_SHARE * spec.friction)
+        whole = make_hold(RungSeed("left_foot", rung, 0.11), geom, DRC_HUBO,
+                          friction_share=1.0)
+        assert whole.friction == spec.friction
         # Contact corners lie on the tread, the centre-of-pressure margin inside its
         # edges and the sole's sides.
         local = geom.to_ladder(hold.points_m)
@@ -51,6 +62,7 @@ def test_rail_holds_follow_the_ladder_placement():
     for s in (spec, moved):
         geom = LadderGeometry(s)
         hold = make_hold(RailSeed("right_hand", "right", 3), geom, DRC_HUBO)
+        assert hold.friction == s.friction  # the grip's model keeps the whole μ
         p = hold.T_world_frame[:3, 3]
         assert np.linalg.norm(geom.closest_rail_point("right", p) - p) < 1e-9
         # The grip axis runs along the rail.
