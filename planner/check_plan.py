@@ -35,7 +35,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import SimpleNamespace
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
@@ -45,7 +45,8 @@ from robot.errors import HuboLadderError, InputError, TrajectoryFileError
 from robot.plan_sidecar import PlanSidecar, Segment
 
 if TYPE_CHECKING:
-    from planner.stability import TorqueCheck
+    from planner.contacts import Stance
+    from planner.stability import SupportRegion, TorqueCheck
 
 __all__ = ["CheckResult", "HOLD_TOL_M", "PlannedLoad", "allowed_contacts", "check_plan", "main",
            "planned_loads"]
@@ -124,6 +125,15 @@ def allowed_contacts(segments: Sequence[Segment], index: int, fraction: float
         if choice is not None:
             contacts[limb] = choice
     return contacts
+
+
+class _SegmentStance(NamedTuple):
+    """A segment's holds as the checks use them (`_Verifier.stance`)."""
+
+    stance: Stance
+    region: SupportRegion  # the CoM's, on the holds that may balance it
+    torque_limits: dict[str, float]  # [N·m]
+    balance_limbs: tuple[str, ...]  # those holds (`planner.arm_capacity.balance_stance`)
 
 
 class _Verifier:
@@ -235,7 +245,7 @@ class _Verifier:
         pts = sole_contact_points(self.params, T, (x0, x1), margin_m=0.0)
         return Hold(limb, record.target, T, pts, np.tile(up, (4, 1)), mu)
 
-    def stance(self, seg_index: int, seg: Segment):
+    def stance(self, seg_index: int, seg: Segment) -> _SegmentStance:
         """The stance of a segment, its support region and its joint torque limits [N·m]
         (arms whose hands hold a rail driven as the plan's arm strategy drives them; the
         planner's capacity model is robot data), cached."""
@@ -246,9 +256,10 @@ class _Verifier:
             stance = Stance(tuple(self.contact_hold(lb, h) for lb, h in sorted(seg.holds.items())))
             limits = gripping_torque_limits(self.torque_max, gripping_sides(seg.holds),
                                             self.arm_strategy)
-            region = support_region(balance_stance(stance, self.arm_strategy),
-                                    self.params.total_mass_kg)
-            self._stances[seg_index] = (stance, region, limits)
+            balance = balance_stance(stance, self.arm_strategy)
+            self._stances[seg_index] = _SegmentStance(
+                stance, support_region(balance, self.params.total_mass_kg), limits,
+                tuple(sorted(balance.limbs)))
         return self._stances[seg_index]
 
 
@@ -296,8 +307,9 @@ def planned_loads(traj_rad: np.ndarray, sidecar: PlanSidecar, spec, lines: Seque
         if q is None:
             out.append(PlannedLoad(line, None, None))
             continue
-        stance, _, limits = v.stance(si, seg)
-        torque = torque_feasibility(v.model, v.data, q, stance, limits, v.frame_id)
+        held = v.stance(si, seg)
+        torque = torque_feasibility(v.model, v.data, q, held.stance, held.torque_limits,
+                                    v.frame_id)
         base = np.eye(4)
         base[:3, :3] = v.pin.Quaternion(q[6], q[3], q[4], q[5]).toRotationMatrix()
         base[:3, 3] = q[:3]
@@ -411,8 +423,9 @@ def check_plan(traj_rad: np.ndarray, sidecar: PlanSidecar, spec, robot: str | No
             if hit or (line - 1) % CLEARANCE_EVERY_LINES == 0:
                 rep = v.collision.report(q)
                 clear, pair = rep.min_distance_m, " – ".join(rep.closest_pair)
-            stance, region, torque_limits = v.stance(si, seg)
-            rep_s = check_stability(v.model, v.data, q, stance, region, torque_limits)
+            held = v.stance(si, seg)
+            rep_s = check_stability(v.model, v.data, q, held.stance, held.region,
+                                    held.torque_limits)
             tq = rep_s.torque
             out = (hit, clear, pair, rep_s.margin_m,
                    math.inf if tq is None else tq.max_ratio, "" if tq is None else tq.worst_joint,
@@ -423,10 +436,10 @@ def check_plan(traj_rad: np.ndarray, sidecar: PlanSidecar, spec, robot: str | No
             d = clear if not math.isnan(clear) else 0.0
             res["collision"].offer(line, -d + (1.0 if hit else 0.0), d,
                                    f"{label}: {pair or 'in collision'}", hit)
-        balance = balance_stance(v.stance(si, seg)[0], v.arm_strategy).limbs
+        balance = v.stance(si, seg).balance_limbs
         res["stability margin"].offer(line, -margin, margin,
                                       f"{label}: CoM margin {margin * 100:.1f} cm in the "
-                                      f"support region of {', '.join(sorted(balance))}",
+                                      f"support region of {', '.join(balance)}",
                                       margin < 0.0)
         if margin >= 0.0:
             res["torque ratio"].offer(line, ratio_t, ratio_t, f"{label}: worst joint {joint}",

@@ -276,10 +276,7 @@ class ClimbPlanner:
             T = np.eye(4)
             T[:3, 3] = kin.frame_pose(q, frame)[:3, 3] * [1, 1, 0]
             floor[limb] = T
-        holds = tuple(make_hold(FloorSeed(limb), self.geom, kin.params, floor,
-                                cop_margin_m=self.config.foot_cop_margin_m,
-                                friction_share=self.config.foot_friction_share)
-                      for limb in floor)
+        holds = tuple(self._make_hold(FloorSeed(limb), floor_pose=floor) for limb in floor)
         return self._project(q, holds), Stance(holds)
 
     def _project(self, q: np.ndarray, holds: tuple[Hold, ...]) -> np.ndarray:
@@ -331,8 +328,13 @@ class ClimbPlanner:
             shoulder = self.kin.frame_pose(q, frame)[:3, 3]
         first = GRIP_STYLES.index(self.preferred_grip)
         style = GRIP_STYLES[(first + attempt) % len(GRIP_STYLES)]
-        return make_hold(seed, self.geom, self.kin.params, offset_m=(along, lateral),
-                         shoulder_m=shoulder, grip_style=style,
+        return self._make_hold(seed, offset_m=(along, lateral), shoulder_m=shoulder,
+                               grip_style=style)
+
+    def _make_hold(self, seed, **kwargs) -> Hold:
+        """`make_hold` with this planner's ladder, robot and foot model (the centre of
+        pressure margin and the friction share)."""
+        return make_hold(seed, self.geom, self.kin.params, **kwargs,
                          cop_margin_m=self.config.foot_cop_margin_m,
                          friction_share=self.config.foot_friction_share)
 
