@@ -12,9 +12,14 @@ sagged) is drawn onto the axis; a compliant arm gives way, a stiff one fights th
 When it latches (all of):
 
 - the fingers are commanded closed (sent reference ≥ ``closed_fraction`` ·
-  ``FINGER_CLOSED_RAD``) and are closed (measured mean curl at least that). The board
-  model keeps fingers from colliding with the rails (their capsules' curl sweeps through
-  the grip centre): the grip is this latch, not finger contact;
+  ``FINGER_CLOSED_RAD``) and their mean curl reaches the rail: the curl at which a finger
+  meets a rail lying at the grip centre (`robot.kinematic_tree.finger_contact_curl_rad`,
+  0.09 rad for a 25 mm rail). The board model keeps fingers from colliding with the
+  rails (their single-link capsules' curl sweeps through the grip centre): the grip is
+  this latch, not finger contact. While latched the fingers stop at that curl (their
+  joints' upper range is set to it), as real fingers stop on the rail they wrap, so the
+  finger encoders read a closed grip on a rail; fingers that pass it closed on nothing
+  and go on to ``FINGER_CLOSED_RAD``;
 - the hand was open before (a fist that closed on nothing does not grasp a rail it
   meets later: it must open first);
 - its palm site (the grip centre) is within ``position_tolerance_m`` of a rail axis and
@@ -79,7 +84,7 @@ from enum import Enum
 import mujoco
 import numpy as np
 
-from robot.kinematic_tree import FINGER_CLOSED_RAD
+from robot.kinematic_tree import FINGER_CLOSED_RAD, finger_contact_curl_rad
 
 __all__ = ["RELEASE_LOADS", "SLIP_LOADS", "GraspEvent", "GraspLatch", "GripCapacity",
            "GripConfig", "GripState"]
@@ -250,6 +255,10 @@ class GraspLatch:
         self.rails = rails
         self.friction, self.rail_radius_m = friction, rail_radius_m
         self.capacity = GripCapacity.of(self.config, friction, rail_radius_m)
+        self.rail_contact_curl_rad = finger_contact_curl_rad(rail_radius_m)
+        joint_of_qpos = {int(model.jnt_qposadr[j]): j for j in range(model.njnt)}
+        self._finger_joints = np.array([joint_of_qpos[int(a)] for a in self.finger_qpos])
+        self._finger_range = model.jnt_range[self._finger_joints].copy()
         self._jac = np.zeros((6, model.nv))  # palm site: translation rows, rotation rows
         self._qfrc = np.zeros(model.nv)
         self.reset()
@@ -258,12 +267,21 @@ class GraspLatch:
     def reset(self) -> None:
         """Open hand, weld off."""
         self.state = GripState.OPEN
+        self._passed_rail = False
         self.rail: str | None = None
         self._overload_s = 0.0
         self.slip_m = self.slip_rad = 0.0
         self.peak_utilisation = 0.0
         self.last_utilisation = (0.0, "")
         self.data.eq_active[self.eq_id] = 0
+        self._fingers_on_rail(False)
+
+    def _fingers_on_rail(self, on: bool) -> None:
+        """Stop the fingers where they meet the rail (latched), or free them."""
+        rng = self.model.jnt_range
+        rng[self._finger_joints] = self._finger_range
+        if on:
+            rng[self._finger_joints, 1] = self.rail_contact_curl_rad
 
     @property
     def latched(self) -> bool:
@@ -329,20 +347,28 @@ class GraspLatch:
         if self.state is GripState.CLOSED_EMPTY:
             if opening and curl < cfg.open_fraction * FINGER_CLOSED_RAD:
                 self.state = GripState.OPEN
+                self._passed_rail = False
             return None
         # OPEN
         if not (closed_ref and finger_board_ok):
+            if curl < self.rail_contact_curl_rad:
+                self._passed_rail = False
             return None
+        if curl < self.rail_contact_curl_rad:
+            return None  # still closing, not yet where a rail in the hand would stop them
         near = self.palm_to_rails()
         rail = min(near, key=lambda r: near[r][0])
         dist, ang = near[rail]
-        if curl < cfg.closed_fraction * FINGER_CLOSED_RAD:
-            return None  # still closing
-        if dist <= cfg.position_tolerance_m and ang <= cfg.angle_tolerance_rad:
+        within = dist <= cfg.position_tolerance_m and ang <= cfg.angle_tolerance_rad
+        if within and not self._passed_rail:
+            self._fingers_on_rail(True)
             self._latch(rail)
             return GraspEvent(self.hand, "latched", time_s, rail,
                               f"palm {dist * 100:.1f} cm from the axis, grip axis "
                               f"{math.degrees(ang):.0f}° off", dist, ang)
+        self._passed_rail = True  # the fingers went past where a rail would stop them
+        if curl < cfg.closed_fraction * FINGER_CLOSED_RAD:
+            return None  # still closing, on nothing
         self.state = GripState.CLOSED_EMPTY
         why = []
         if dist > cfg.position_tolerance_m:
@@ -417,6 +443,7 @@ class GraspLatch:
     def _release(self, time_s: float, reason: str, new_state: GripState) -> GraspEvent:
         rail = self.rail
         self.data.eq_active[self.eq_id] = 0
+        self._fingers_on_rail(False)
         self.state = new_state
         self.rail = None
         self._overload_s = 0.0

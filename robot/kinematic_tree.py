@@ -7,6 +7,7 @@ URDF, MJCF and the planner's collision model are all written from this one tree.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -183,6 +184,29 @@ def _leg(p: RobotParams, side: str) -> list[Link]:
 FINGER_CLOSED_RAD = 1.6
 FINGER_LENGTH_M = 0.09
 FINGER_RADIUS_M = 0.011
+#: A finger joint sits this far beside the grip centre, on the palm plate's side [m] ...
+FINGER_JOINT_OUTSET_M = 0.04
+#: ... and this far above it, towards the wrist [m].
+FINGER_JOINT_ABOVE_GRIP_M = 0.045
+
+
+def finger_contact_curl_rad(rail_radius_m: float) -> float:
+    """The curl [rad] at which a closing finger meets a rail whose axis lies at the grip
+    centre: where the finger capsule's axis passes ``rail_radius_m + FINGER_RADIUS_M``
+    from the rail axis.
+
+    A finger hangs from its joint at ``(−outset, +above)`` (across the grip, along the
+    palm) and curls towards the open side; at curl θ its axis runs along
+    ``(sin θ, −cos θ)``, whose distance from the grip centre is
+    ``outset·cos θ − above·sin θ``. A hand closed on a rail stops there, one closed on
+    nothing reaches ``FINGER_CLOSED_RAD``: the finger encoders tell the two apart. A rail
+    too thick to enter the open hand stops the fingers at 0.
+    """
+    a, b = FINGER_JOINT_OUTSET_M, FINGER_JOINT_ABOVE_GRIP_M
+    ratio = (rail_radius_m + FINGER_RADIUS_M) / math.hypot(a, b)
+    if ratio >= 1.0:
+        return 0.0
+    return max(0.0, math.acos(ratio) - math.atan2(b, a))
 
 
 def _arm(p: RobotParams, side: str) -> tuple[list[Link], list[Frame]]:
@@ -230,7 +254,8 @@ def _arm(p: RobotParams, side: str) -> tuple[list[Link], list[Frame]]:
         joint = f"{side}F{i + 1}"
         links.append(
             _limb(f"{side}_finger{i + 1}", f"{side}_hand", joint, (s, 0, 0),
-                  (x, -s * 0.04, palm_z + 0.045), finger_mass, FINGER_LENGTH_M,
+                  (x, -s * FINGER_JOINT_OUTSET_M, palm_z + FINGER_JOINT_ABOVE_GRIP_M),
+                  finger_mass, FINGER_LENGTH_M,
                   FINGER_RADIUS_M, p)
         )
     frames = [Frame(f"{side}_palm", f"{side}_hand", (0.0, 0.0, palm_z))]

@@ -23,6 +23,7 @@ from execute.metrics import compute_metrics  # noqa: E402
 from execute.simulate import SimulationOptions, simulate  # noqa: E402
 from ladders.spec import LadderSpec  # noqa: E402
 from robot.joints import ARM_JOINTS, FINGER_JOINTS, JOINT_INDEX, NUM_JOINTS  # noqa: E402
+from robot.kinematic_tree import FINGER_CLOSED_RAD  # noqa: E402
 from robot.plan_sidecar import read_sidecar, sidecar_path  # noqa: E402
 from robot.trajectory_file import read_trajectory  # noqa: E402
 
@@ -40,6 +41,15 @@ def latched_run(plan):
     return simulate(traj, sc, ladder, SimulationOptions(strategy="mixed", record_qpos=False))
 
 
+def _holding_ref(board) -> np.ndarray:
+    """The pose where the robot stands, both hands commanded closed (a latched hand's
+    fingers stand on the rail, short of the closed reference)."""
+    ref = board.joint_pos()
+    for hand in ("left", "right"):
+        ref[[JOINT_INDEX[f] for f in FINGER_JOINTS[hand]]] = FINGER_CLOSED_RAD
+    return ref
+
+
 def _hold(run, ticks: int, ref: np.ndarray, extra=None, limp_arm: str | None = None) -> list:
     """Keep stepping a finished run's board with the control law at ``ref``; the arm
     ``limp_arm`` in PWM with its reference on its encoder (no stiffness)."""
@@ -48,6 +58,9 @@ def _hold(run, ticks: int, ref: np.ndarray, extra=None, limp_arm: str | None = N
     gains = default_drc_gains()
     comply = np.zeros(NUM_JOINTS, dtype=bool)
     mode = np.full(NUM_JOINTS, int(RefMode.FILTER), dtype=np.int8)
+    # the fingers' sent reference is the commanded one from the first tick (a fresh
+    # controller's filter would start from the encoders, which stand on the rail)
+    mode[[JOINT_INDEX[f] for hand in FINGER_JOINTS.values() for f in hand]] = RefMode.DIRECT
     if limp_arm is not None:
         arm = [JOINT_INDEX[n] for n in ARM_JOINTS[limp_arm]]
         comply[arm], mode[arm] = True, RefMode.COMPLIANT
@@ -101,8 +114,20 @@ def test_palm_off_the_rail_grasps_nothing(plan):
     assert run.verdict.failure.cause == "grasp_not_latched"
 
 
+def test_fingers_stop_on_the_rail_they_hold(latched_run):
+    """The finger encoders tell a grip on a rail from a fist: latched fingers stop where
+    they meet the rail, far short of fully closed."""
+    board = latched_run.board
+    for hand in ("left", "right"):
+        curl = board.joint_pos()[[JOINT_INDEX[f] for f in FINGER_JOINTS[hand]]]
+        stop = board.latches[hand].rail_contact_curl_rad
+        assert board.latches[hand].latched
+        assert np.all(np.abs(curl - stop) < 0.06)  # the joint limit is a soft constraint
+        assert np.all(curl < 0.5 * FINGER_CLOSED_RAD)
+
+
 def test_releases_when_fingers_open(latched_run, plan):
-    ref = latched_run.board.joint_pos()
+    ref = _holding_ref(latched_run.board)
     ref[[JOINT_INDEX[f] for f in FINGER_JOINTS["left"]]] = 0.0
     events = _hold(latched_run, 200, ref)
     assert any(g.kind == "released" and g.hand == "left" and "open" in g.reason
@@ -117,7 +142,7 @@ def test_releases_over_load(plan):
     board = run.board
     hand = board.latches["right"].body_id
     cap = board.latches["right"].capacity
-    ref = board.joint_pos()
+    ref = _holding_ref(board)
     # below capacity: holds
     board.data.xfrc_applied[hand, :3] = (0.0, 0.0, -0.5 * cap.radial_n)
     assert not _hold(run, 40, ref)
@@ -191,7 +216,7 @@ def test_a_grip_turns_on_its_rail_and_holds(plan):
         force, torque = latch.grip_load()
         about_rail.append(latch.capacity.utilisation(force, torque, axis)["torque about the rail"])
 
-    events = _hold(run, 100, run.board.joint_pos(), record, limp_arm="right")
+    events = _hold(run, 100, _holding_ref(run.board), record, limp_arm="right")
     assert not events and latch.latched
     assert latch.slip_rad > 0.0
     assert compute_metrics(run).hand_turn_on_rail_rad["right"] == latch.slip_rad
