@@ -1,0 +1,83 @@
+"""The motion layer's tunables, each refused outside its safe range."""
+
+from __future__ import annotations
+
+import enum
+import math
+from dataclasses import dataclass, field
+
+from execute.motion.estimator import EstimatorConfig
+from robot.errors import InputError
+
+__all__ = ["HoldingArmReference", "MotionConfig", "MotionConfigError", "default_config"]
+
+
+class MotionConfigError(InputError):
+    """A motion-layer setting outside its safe range; names the field and the range."""
+
+    def __init__(self, field_name: str, value: object, allowed: tuple[float, float]):
+        self.field, self.value, self.allowed = field_name, value, allowed
+        super().__init__(f"motion layer {field_name} = {value!r}: allowed "
+                         f"[{allowed[0]:g}, {allowed[1]:g}]")
+
+
+class HoldingArmReference(enum.Enum):
+    """What a compliant arm whose hand holds a verified grip is stiff towards."""
+
+    PLAN = "plan"  #: the plan's reference, through the daemon's filter (hubo-ach's PWM law)
+    SENSED = "sensed"  #: its own encoders (mode COMPLIANT): feed-forward and damping only
+
+
+#: field → (lowest, highest) allowed value.
+_RANGES = {
+    "max_reach_correction_m": (0.0, 0.10),
+    "max_reach_correction_rad": (0.0, math.radians(30.0)),
+    "grasp_retries": (0, 8),
+    "search_step_m": (0.005, 0.05),
+    "open_s": (0.2, 5.0),
+    "shift_s": (0.2, 5.0),
+    "close_s": (0.2, 5.0),
+    "verify_timeout_s": (0.1, 5.0),
+    "hold_after_stop_s": (0.0, 30.0),
+}
+
+
+@dataclass(frozen=True)
+class MotionConfig:
+    """Attributes:
+        gravity_compensation: feed the compliant arms the model's gravity torques at the
+            sensed configuration and IMU tilt (thesis §4.3.4) instead of the plan's.
+        holding_arm_reference: what a gripping compliant arm is stiff towards.
+        max_reach_correction_m: largest shift of a hold target, estimate plus search [m].
+        max_reach_correction_rad: largest ladder yaw the estimate may apply [rad].
+        grasp_retries: re-reaches after a grasp the fingers show empty.
+        search_step_m: spacing of the re-reach pattern around the target [m].
+        open_s, shift_s, close_s: durations of a re-reach's opening, move and closing [s].
+        verify_timeout_s: how long a closed hand may take to read on-rail or empty [s].
+        hold_after_stop_s: how long the pose is held after the layer stops, before the
+            run ends (validation only) [s].
+        estimator: the state estimator's thresholds.
+    """
+
+    gravity_compensation: bool = True
+    holding_arm_reference: HoldingArmReference = HoldingArmReference.PLAN
+    max_reach_correction_m: float = 0.06
+    max_reach_correction_rad: float = math.radians(15.0)
+    grasp_retries: int = 4
+    search_step_m: float = 0.025
+    open_s: float = 0.8
+    shift_s: float = 1.5
+    close_s: float = 1.0
+    verify_timeout_s: float = 1.5
+    hold_after_stop_s: float = 2.0
+    estimator: EstimatorConfig = field(default_factory=EstimatorConfig)
+
+    def __post_init__(self) -> None:
+        for name, (lo, hi) in _RANGES.items():
+            value = getattr(self, name)
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and lo <= value <= hi):
+                raise MotionConfigError(name, value, (lo, hi))
+
+
+def default_config() -> MotionConfig:
+    return MotionConfig()

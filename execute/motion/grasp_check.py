@@ -1,0 +1,48 @@
+"""Is the hand closed on its rail? Read from the finger encoders alone.
+
+A hand's fingers stop where they meet a rail lying in the grip
+(`robot.kinematic_tree.finger_contact_curl_rad`: 0.09 rad on a 25 mm rail) and close to
+``FINGER_CLOSED_RAD`` (1.6 rad) on nothing. So, with the fingers commanded closed:
+
+- **on rail**: the mean curl stands still below half of closed;
+- **empty**: it has passed ``empty_fraction`` of closed;
+- **closing**: neither yet.
+
+The thesis's operator could not tell this from the wrist F/T sensors (§6.2: their fz
+varied with the climbing forces, not with the grasp); finger closure on the rail's
+diameter can.
+"""
+
+from __future__ import annotations
+
+import enum
+
+import numpy as np
+
+from robot.joints import FINGER_JOINTS, joint_indices
+from robot.kinematic_tree import FINGER_CLOSED_RAD
+
+__all__ = ["GraspReading", "read_grasp"]
+
+_FINGER_COLS = {side: joint_indices(FINGER_JOINTS[side]) for side in FINGER_JOINTS}
+ON_RAIL_FRACTION = 0.5  #: below this share of closed, a still hand holds something
+EMPTY_FRACTION = 0.8  #: past this share of closed, the hand closed on nothing
+STILL_RAD_S = 0.2  #: mean finger speed under which the fingers stand still [rad/s]
+
+
+class GraspReading(enum.Enum):
+    ON_RAIL = "on rail"
+    EMPTY = "closed on nothing"
+    CLOSING = "closing"
+
+
+def read_grasp(side: str, pos_rad: np.ndarray, vel_rad_s: np.ndarray) -> GraspReading:
+    """What the finger encoders of one hand, commanded closed, say (module docstring)."""
+    cols = _FINGER_COLS[side]
+    curl = float(np.mean(pos_rad[cols]))
+    speed = float(np.mean(np.abs(vel_rad_s[cols])))
+    if curl >= EMPTY_FRACTION * FINGER_CLOSED_RAD:
+        return GraspReading.EMPTY
+    if curl < ON_RAIL_FRACTION * FINGER_CLOSED_RAD and speed < STILL_RAD_S:
+        return GraspReading.ON_RAIL
+    return GraspReading.CLOSING

@@ -1,0 +1,420 @@
+"""The motion layer: closed-loop playback of a plan on sensed state.
+
+It sits between the trajectory player and the daemon's control law, and rebuilds what
+hubo-motion-rt and the thesis's operator did (thesis §4.3.4, §6.2):
+
+- **gravity compensation** of the compliant arms (`execute.motion.gravity_compensation`);
+- **grasp verification**: at the end of every grasp the plan makes, the player waits
+  until the finger encoders read the hand closed on its rail
+  (`execute.motion.grasp_check`). Only then does the plan go on to put load on it;
+- **re-reach**: a hand that closed on nothing opens, moves to the next point of a small
+  pattern around its target (across the rail, towards and away from the ladder, and
+  sideways), and closes again, up to ``grasp_retries`` times. If it still holds nothing
+  the layer **stops**: the player stays paused, every verified grip is kept, and the
+  climb ends with the reason. The weight never moves onto an unverified grasp;
+- **reach correction**: every verified grasp measures where its rail is
+  (`execute.motion.ladder_estimate`); every later reach of a hand or a foot to a hold on
+  the ladder is re-targeted by that estimate, by inverse kinematics on the limb's chain
+  from the plan's end pose of the reach (`execute.motion.robot_model`), blended in over
+  the reach and kept while the limb holds. Corrections are bounded
+  (`MotionConfig.max_reach_correction_m`).
+
+Its only input is the daemon's state struct (`execute.motion.sensed_state`). It writes
+references, modes and feed-forward, the same things the open-loop player writes.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+from dataclasses import dataclass
+
+import numpy as np
+
+from daemon.control_modes import RefMode
+from execute.motion.config import HoldingArmReference, MotionConfig
+from execute.motion.estimator import BodyEstimate, StateEstimator
+from execute.motion.events import MotionEvent, MotionEventKind, MotionStop
+from execute.motion.grasp_check import GraspReading, read_grasp
+from execute.motion.gravity_compensation import ArmGravityCompensation
+from execute.motion.ladder_estimate import LadderEstimate, RailObservation
+from execute.motion.robot_model import MotionRobotModel
+from execute.motion.sensed_state import SensedState
+from execute.play.player import PlayerTick, TrajectoryPlayer
+from ladders.geometry import LadderGeometry
+from ladders.spec import LadderSpec
+from robot.joints import ARM_JOINTS, FINGER_JOINTS, joint_indices
+from robot.plan_sidecar import PlanSidecar, Segment
+
+__all__ = ["MotionLayer"]
+
+log = logging.getLogger(__name__)
+
+SIDES = ("left", "right")
+#: Re-reach pattern, in search steps (towards the ladder across the rail, sideways).
+SEARCH_PATTERN = ((1, 0), (0, 1), (0, -1), (-1, 0), (2, 0), (1, 1), (1, -1), (-2, 0))
+#: A correction smaller than this is not applied [m].
+MIN_CORRECTION_M = 0.002
+#: Two targets closer than this are the same [m].
+SAME_TARGET_M = 0.005
+
+
+def _side(limb: str) -> str:
+    return limb.split("_")[0]
+
+
+def _min_jerk(u: float) -> float:
+    u = min(max(u, 0.0), 1.0)
+    return u * u * u * (10.0 + u * (-15.0 + 6.0 * u))
+
+
+@dataclass
+class _Blend:
+    """A limb's joint offset moving from ``start`` to ``end`` between two lines (or two
+    times, while the player waits)."""
+
+    start: np.ndarray
+    end: np.ndarray
+    t0: float
+    t1: float
+    time_based: bool = False  #: t0, t1 are times [s] (a re-reach), not line indices
+
+    def at(self, t: float) -> np.ndarray:
+        if self.t1 <= self.t0:
+            return self.end
+        return self.start + _min_jerk((t - self.t0) / (self.t1 - self.t0)) * (self.end - self.start)
+
+
+@dataclass
+class _Regrasp:
+    """A hand that is being verified or re-reached while the player waits."""
+
+    side: str
+    segment: int
+    rail: str
+    planned_m: np.ndarray
+    phase: str  # "retarget", "verify", "open", "shift", "close"
+    since_s: float
+    tries: int = 0
+    candidates: list = dataclasses.field(default_factory=list)  # re-reach shifts [m]
+
+
+class MotionLayer:
+    """Closed-loop playback (module docstring).
+
+    Args:
+        player: the trajectory player (the layer pauses and resumes it).
+        trajectory_rad: the plan, shape (N, 40) [rad].
+        sidecar: its sidecar (segments, holds).
+        ladder: the ladder the plan was made for.
+        robot: robot name.
+        config: tunables.
+    """
+
+    def __init__(self, player: TrajectoryPlayer, trajectory_rad: np.ndarray,
+                 sidecar: PlanSidecar, ladder: LadderSpec, robot: str = "drc-hubo",
+                 config: MotionConfig | None = None):
+        self.player = player
+        self.trajectory_rad = trajectory_rad
+        self.sidecar = sidecar
+        self.config = config or MotionConfig()
+        self.geometry = LadderGeometry(ladder)
+        self.model = MotionRobotModel(robot)
+        first = sidecar.segments[0]
+        soles = {_side(limb): np.asarray(h.position_m) for limb, h in first.holds.items()
+                 if limb.endswith("_foot")}
+        self.estimator = StateEstimator(self.model, soles, self.config.estimator)
+        self.gravity = ArmGravityCompensation(self.model)
+        self.ladder = LadderEstimate(self.config.max_reach_correction_m,
+                                     self.config.max_reach_correction_rad)
+        n = len(trajectory_rad)
+        self._segment_of_line = np.zeros(n, dtype=np.int32)
+        for k, seg in enumerate(sidecar.segments):
+            self._segment_of_line[seg.first_line - 1:seg.last_line] = k
+        self._next_hold = self._next_holds(sidecar.segments)
+        self._finger_cols = {side: joint_indices(FINGER_JOINTS[side]) for side in SIDES}
+        self._arm_cols = {side: joint_indices(ARM_JOINTS[side]) for side in SIDES}
+        self._offsets: dict[str, _Blend] = {}
+        self._shift_m: dict[str, np.ndarray] = {}  # limb → world shift its offset makes [m]
+        self._segment = -1
+        self._verified_segments: set[tuple[int, str]] = set()
+        self._regrasp: _Regrasp | None = None
+        self._open_fingers: set[str] = set()
+        self.events: list[MotionEvent] = []
+        self.stop: MotionStop | None = None
+        self.estimate: BodyEstimate | None = None
+        self._line = 0
+
+    # ------------------------------------------------------------------ plan queries
+    @staticmethod
+    def _next_holds(segments: tuple[Segment, ...]) -> list[dict]:
+        """Per segment: moving limb → (segment index, hold) of the hold it goes to."""
+        out = []
+        for k, seg in enumerate(segments):
+            targets = {}
+            for limb in seg.moving_limbs:
+                for j in range(k + 1, len(segments)):
+                    if limb in segments[j].holds:
+                        targets[limb] = (j, segments[j].holds[limb])
+                        break
+            out.append(targets)
+        return out
+
+    def _on_ladder(self, target: str) -> bool:
+        return target != "floor"
+
+    def _rail_direction(self, rail: str) -> np.ndarray:
+        p0, p1 = self.geometry.rail_axis(rail.removeprefix("rail_"))
+        return (p1 - p0) / np.linalg.norm(p1 - p0)
+
+    # ------------------------------------------------------------------ events
+    def _event(self, kind: MotionEventKind, limb: str, size_m: float, cause: str) -> None:
+        ev = MotionEvent(kind, self._now, self._line + 1, self._segment, limb, size_m, cause)
+        log.info("%s", ev)
+        self.events.append(ev)
+
+    # ------------------------------------------------------------------ offsets
+    def _offset(self, limb: str, t: float) -> np.ndarray | None:
+        blend = self._offsets.get(limb)
+        return None if blend is None else blend.at(t)
+
+    def _limb_shift_dq(self, limb: str, line_index: int, shift_world_m: np.ndarray
+                       ) -> tuple[np.ndarray, float]:
+        """Joint offsets that move ``limb`` by ``shift_world_m`` at the plan's pose of
+        ``line_index``."""
+        R_world_pelvis = self.estimate.T_world_pelvis[:3, :3]
+        yaw = self.ladder.yaw_rad
+        c, s = np.cos(yaw), np.sin(yaw)
+        turn_world = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+        return self.model.limb_correction(self.trajectory_rad[line_index],
+                                          self.model.chains[limb],
+                                          R_world_pelvis.T @ shift_world_m,
+                                          R_world_pelvis.T @ turn_world @ R_world_pelvis)
+
+    def _bounded(self, shift_m: np.ndarray) -> np.ndarray:
+        length = float(np.linalg.norm(shift_m))
+        cap = self.config.max_reach_correction_m
+        return shift_m if length <= cap else shift_m * (cap / length)
+
+    def _enter_segment(self, k: int) -> None:
+        """Re-target the reaches of segment ``k`` from the ladder estimate."""
+        seg = self.sidecar.segments[k]
+        for limb, (_j, hold) in self._next_hold[k].items():
+            if seg.phase != "limb" or not self._on_ladder(hold.target):
+                continue
+            current = self._offset(limb, float(self._line))
+            shift = self._bounded(self.ladder.correction_m(hold.position_m)) \
+                if self.ladder.observed else np.zeros(3)
+            if float(np.linalg.norm(shift)) < MIN_CORRECTION_M:
+                if current is None:
+                    continue
+                dq, residual = np.zeros_like(current), 0.0
+            else:
+                dq, residual = self._limb_shift_dq(limb, seg.last_line - 1, shift)
+            start = current if current is not None else np.zeros_like(dq)
+            self._offsets[limb] = _Blend(start, dq, float(seg.first_line - 1),
+                                         float(seg.last_line - 1))
+            self._shift_m[limb] = shift
+            self._event(MotionEventKind.REACH_CORRECTION, limb, float(np.linalg.norm(shift)),
+                        f"{hold.target} estimated {np.round(shift * 100, 1).tolist()} cm from "
+                        f"the plan (IK residual {residual * 1000:.1f} mm)")
+
+    # ------------------------------------------------------------------ grasps
+    def _pending_grasp(self, k: int) -> tuple[str, str, np.ndarray] | None:
+        """(side, rail, planned hold) of the hand segment ``k`` closes, if not yet verified."""
+        seg = self.sidecar.segments[k]
+        if seg.phase != "grasp":
+            return None
+        for limb, (_j, hold) in self._next_hold[k].items():
+            side = _side(limb)
+            if limb.endswith("_hand") and hold.target.startswith("rail") \
+                    and (k, side) not in self._verified_segments:
+                return side, hold.target, np.asarray(hold.position_m)
+        return None
+
+    def _grasp_due(self, line_index: int) -> _Regrasp | None:
+        """A grasp that ends on this line and is not yet verified; or, on a grasp's first
+        line, a hand whose target the ladder estimate has moved since it reached."""
+        k = int(self._segment_of_line[line_index])
+        seg = self.sidecar.segments[k]
+        pending = self._pending_grasp(k)
+        if pending is None:
+            return None
+        side, rail, planned = pending
+        if line_index >= seg.last_line - 1:
+            return _Regrasp(side, k, rail, planned, "verify", self._now)
+        if line_index == seg.first_line - 1 and self.ladder.observed:
+            limb = f"{side}_hand"
+            wanted = self._bounded(self.ladder.correction_m(planned))
+            if np.linalg.norm(wanted - self._shift_m.get(limb, np.zeros(3))) > SAME_TARGET_M:
+                g = _Regrasp(side, k, rail, planned, "retarget", self._now)
+                self._move_hand(g, wanted, "the ladder estimate moved its target")
+                return g
+        return None
+
+    def _candidates(self, g: _Regrasp) -> list[np.ndarray]:
+        """Re-reach shifts [m]: the ladder estimate's target, then a pattern around it,
+        each within the bound and different from where the hand closed last."""
+        centre = self.ladder.correction_m(g.planned_m) if self.ladder.observed else np.zeros(3)
+        towards_ladder = -self.geometry.rung_line_normal
+        step = self.config.search_step_m
+        out: list[np.ndarray] = []
+        for across, lateral in ((0, 0),) + SEARCH_PATTERN:
+            shift = self._bounded(centre + step * (across * towards_ladder
+                                                   + lateral * self.geometry.lateral_direction))
+            tried = [self._shift_m.get(f"{g.side}_hand", np.zeros(3))] + out
+            if all(np.linalg.norm(shift - t) > SAME_TARGET_M for t in tried):
+                out.append(shift)
+        return out
+
+    def _move_hand(self, g: _Regrasp, shift: np.ndarray, why: str) -> None:
+        """Blend the hand's offset to one that moves it by ``shift`` [m], over shift_s."""
+        limb = f"{g.side}_hand"
+        dq, residual = self._limb_shift_dq(limb, self._line, shift)
+        current = self._offset(limb, float(self._line))
+        self._offsets[limb] = _Blend(current if current is not None else np.zeros_like(dq),
+                                     dq, self._now, self._now + self.config.shift_s,
+                                     time_based=True)
+        self._shift_m[limb] = shift
+        kind = MotionEventKind.RE_REACH if g.tries else MotionEventKind.REACH_CORRECTION
+        self._event(kind, limb, float(np.linalg.norm(shift)),
+                    f"{why}: target moved {np.round(shift * 100, 1).tolist()} cm (IK "
+                    f"residual {residual * 1000:.1f} mm)")
+
+    def _update_regrasp(self, s: SensedState) -> None:
+        g, cfg, now = self._regrasp, self.config, self._now
+        limb = f"{g.side}_hand"
+        elapsed = now - g.since_s
+        if g.phase == "retarget":
+            if elapsed >= cfg.shift_s:
+                self._settle_offset(limb)
+                self._regrasp = None
+                self.player.resume(now)
+        elif g.phase in ("verify", "close"):
+            reading = read_grasp(g.side, s.pos_rad, s.vel_rad_s)
+            waited = cfg.verify_timeout_s + (cfg.close_s if g.phase == "close" else 0.0)
+            if reading is GraspReading.ON_RAIL and (g.phase == "verify" or elapsed >= cfg.close_s):
+                self._grasp_verified(g)
+                return
+            if reading is GraspReading.CLOSING and elapsed < waited:
+                return
+            if reading is GraspReading.ON_RAIL:
+                return
+            curl = self.estimate.finger_curl_rad[g.side]
+            off = self.estimate.palm_m[g.side] - g.planned_m
+            self._event(MotionEventKind.GRASP_MISSED, limb, 0.0,
+                        f"fingers at {curl:.2f} rad ({reading.value}) on {g.rail}; palm "
+                        f"{np.round(off * 100, 1).tolist()} cm from the planned hold")
+            if g.tries == 0:
+                g.candidates = self._candidates(g)
+            if g.tries >= min(cfg.grasp_retries, len(g.candidates)):
+                self._stop(g, f"{limb} closed on nothing after {g.tries} re-reach"
+                              f"{'es' if g.tries != 1 else ''} for {g.rail}: the weight was "
+                              "not moved onto it")
+                return
+            g.tries += 1
+            g.phase, g.since_s = "open", now
+            self._open_fingers.add(g.side)
+        elif g.phase == "open" and elapsed >= cfg.open_s:
+            self._move_hand(g, g.candidates[g.tries - 1],
+                            f"try {g.tries} of {cfg.grasp_retries}")
+            g.phase, g.since_s = "shift", now
+        elif g.phase == "shift" and elapsed >= cfg.shift_s:
+            self._open_fingers.discard(g.side)
+            g.phase, g.since_s = "close", now
+
+    def _settle_offset(self, limb: str) -> None:
+        """A time-based offset that has arrived stays while the limb holds: index it by
+        line again."""
+        blend = self._offsets.get(limb)
+        if blend is not None and blend.time_based:
+            self._offsets[limb] = _Blend(blend.end, blend.end, float(self._line),
+                                         float(self._line))
+
+    def _grasp_verified(self, g: _Regrasp) -> None:
+        limb = f"{g.side}_hand"
+        palm = self.estimate.palm_m[g.side]
+        self._verified_segments.add((g.segment, g.side))
+        self._settle_offset(limb)
+        off = palm - g.planned_m
+        self._event(MotionEventKind.GRASP_VERIFIED, limb, 0.0,
+                    f"fingers at {self.estimate.finger_curl_rad[g.side]:.2f} rad on {g.rail}; "
+                    f"palm {np.round(off * 100, 1).tolist()} cm from the planned hold"
+                    + (f" after {g.tries} re-reach{'es' if g.tries != 1 else ''}"
+                       if g.tries else ""))
+        self.ladder.add(RailObservation(g.rail, g.planned_m, palm, self._rail_direction(g.rail)))
+        self._event(MotionEventKind.LADDER_ESTIMATE, "", float(np.linalg.norm(self.ladder.shift_m)),
+                    f"ladder shifted {np.round(self.ladder.shift_m * 100, 1).tolist()} cm, "
+                    f"yawed {np.degrees(self.ladder.yaw_rad):.1f}°")
+        self._regrasp = None
+        self.player.resume(self._now)
+
+    def _stop(self, g: _Regrasp, reason: str) -> None:
+        self._open_fingers.add(g.side)
+        self.stop = MotionStop(self._now, self._line + 1, f"{g.side}_hand", reason, g.tries,
+                               {"rail": g.rail})
+        self._event(MotionEventKind.STOP, f"{g.side}_hand", 0.0, reason)
+        self._regrasp = None
+
+    # ------------------------------------------------------------------ the tick
+    def step(self, now_s: float, state_sample: np.ndarray) -> PlayerTick:
+        """The command of the tick at ``now_s``, from the daemon's state sample."""
+        self._now = now_s
+        s = SensedState.from_sample(state_sample)
+        self.estimate = self.estimator.update(s)
+        if self._regrasp is not None:
+            self._update_regrasp(s)
+        tick = self.player.step(now_s, s.pos_rad)
+        self._line = tick.line_index
+        k = int(self._segment_of_line[tick.line_index])
+        if k != self._segment and not tick.going_to_init:
+            self._segment = k
+            self._enter_segment(k)
+        if self._regrasp is None and self.stop is None and not tick.going_to_init:
+            due = self._grasp_due(tick.line_index)
+            if due is not None:
+                self._regrasp = due
+                self.player.pause(now_s)
+        return self._command(tick, s)
+
+    def _command(self, tick: PlayerTick, s: SensedState) -> PlayerTick:
+        plan_rad = tick.ref_rad
+        ref = plan_rad.copy()
+        for limb, blend in self._offsets.items():
+            t = self._now if blend.time_based else float(tick.line_index)
+            ref += blend.at(t)
+        for side in self._open_fingers:
+            ref[self._finger_cols[side]] = 0.0
+        mode = tick.mode
+        if self.config.holding_arm_reference is HoldingArmReference.SENSED:
+            seg = self.sidecar.segments[int(self._segment_of_line[tick.line_index])]
+            for side in SIDES:
+                hold = seg.holds.get(f"{side}_hand")
+                cols = self._arm_cols[side]
+                if hold is not None and hold.target.startswith("rail") and tick.comply[cols].all():
+                    if mode is tick.mode:
+                        mode = tick.mode.copy()
+                    mode[cols] = RefMode.COMPLIANT
+        ff = tick.feedforward_nm
+        if self.config.gravity_compensation:
+            ff = self.gravity.feedforward_nm(ff, plan_rad, s.pos_rad, self.estimate.R_tilt)
+            ff[~tick.comply] = 0.0
+        return dataclasses.replace(tick, ref_rad=ref, mode=mode, feedforward_nm=ff)
+
+    # ------------------------------------------------------------------ report
+    def report(self) -> dict:
+        """What the layer did, for the result JSON."""
+        counts: dict[str, int] = {}
+        for ev in self.events:
+            counts[ev.kind.value] = counts.get(ev.kind.value, 0) + 1
+        return {
+            "config": {"gravity_compensation": self.config.gravity_compensation,
+                       "holding_arm_reference": self.config.holding_arm_reference.value,
+                       "max_reach_correction_m": self.config.max_reach_correction_m,
+                       "grasp_retries": self.config.grasp_retries},
+            "counts": counts,
+            "ladder_shift_m": [round(float(v), 4) for v in self.ladder.shift_m],
+            "ladder_yaw_rad": round(self.ladder.yaw_rad, 4),
+            "stop": None if self.stop is None else dataclasses.asdict(self.stop),
+            "events": [ev.to_json() for ev in self.events],
+        }

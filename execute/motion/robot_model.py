@@ -1,0 +1,149 @@
+"""The motion layer's robot model: pinocchio on the robot's own URDF.
+
+What hubo-motion-rt computed from the robot description (thesis §4.3.4): gravity torques
+by recursive Newton–Euler at a given configuration and body tilt, frame poses by forward
+kinematics, and small limb corrections by damped least squares on one limb's chain.
+
+Everything here takes the 40 file columns (`robot.joints.JOINT_NAMES` order) and a
+pelvis pose, so callers never handle pinocchio's configuration layout.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+from robot.joints import ARM_JOINTS, JOINT_NAMES, LEG_JOINTS
+from robot.params import robot_params
+from robot.urdf import robot_urdf
+
+__all__ = ["LimbChain", "MotionRobotModel"]
+
+
+@dataclass(frozen=True)
+class LimbChain:
+    """One limb for a correction: its end frame and the columns of its joints."""
+
+    limb: str  # "left_hand", "right_foot", ...
+    frame: str  # pinocchio frame name ("L_palm", "R_sole")
+    columns: tuple[int, ...]  # file columns of the joints that move it
+
+
+class MotionRobotModel:
+    """Gravity, kinematics and limb IK of one robot (see the module docstring).
+
+    Args:
+        robot: robot name (`robot.params.robot_params`).
+    """
+
+    def __init__(self, robot: str = "drc-hubo"):
+        params = robot_params(robot)
+        self.model = pin.buildModelFromXML(robot_urdf(params), pin.JointModelFreeFlyer())
+        self.data = self.model.createData()
+        m = self.model
+        self.mass_kg = float(sum(inertia.mass for inertia in m.inertias))
+        self._q_of_col = np.full(len(JOINT_NAMES), -1)
+        self._v_of_col = np.full(len(JOINT_NAMES), -1)
+        for c, name in enumerate(JOINT_NAMES):
+            if m.existJointName(name):
+                j = m.joints[m.getJointId(name)]
+                self._q_of_col[c], self._v_of_col[c] = j.idx_q, j.idx_v
+        self._have = self._q_of_col >= 0
+        self.lower_rad = np.full(len(JOINT_NAMES), -np.inf)
+        self.upper_rad = np.full(len(JOINT_NAMES), np.inf)
+        self.lower_rad[self._have] = m.lowerPositionLimit[self._q_of_col[self._have]]
+        self.upper_rad[self._have] = m.upperPositionLimit[self._q_of_col[self._have]]
+        self.chains: dict[str, LimbChain] = {}
+        for side, s in (("left", "L"), ("right", "R")):
+            arm = tuple(c for c, n in enumerate(JOINT_NAMES)
+                        if n in ARM_JOINTS[side] and self._have[c])
+            leg = tuple(c for c, n in enumerate(JOINT_NAMES)
+                        if n in LEG_JOINTS[side] and self._have[c])
+            self.chains[f"{side}_hand"] = LimbChain(f"{side}_hand", f"{s}_palm", arm)
+            self.chains[f"{side}_foot"] = LimbChain(f"{side}_foot", f"{s}_sole", leg)
+        self._frame_id = {c.frame: m.getFrameId(c.frame) for c in self.chains.values()}
+
+    # ------------------------------------------------------------------ conversions
+    def configuration(self, q_cols_rad: np.ndarray, T_world_pelvis: np.ndarray | None = None
+                      ) -> np.ndarray:
+        """pinocchio's q for the 40 columns and a pelvis pose (identity when None)."""
+        q = pin.neutral(self.model)
+        q[self._q_of_col[self._have]] = np.asarray(q_cols_rad)[self._have]
+        if T_world_pelvis is not None:
+            q[:3] = T_world_pelvis[:3, 3]
+            q[3:7] = pin.Quaternion(T_world_pelvis[:3, :3]).coeffs()
+        return q
+
+    # ------------------------------------------------------------------ dynamics
+    def gravity_torques(self, q_cols_rad: np.ndarray, R_world_pelvis: np.ndarray) -> np.ndarray:
+        """Joint torques that hold the robot still against gravity [N·m], by column.
+
+        Each joint's torque is that of the bodies beyond it, so only the pelvis's tilt
+        matters, not where it stands.
+        """
+        T = np.eye(4)
+        T[:3, :3] = R_world_pelvis
+        g = pin.computeGeneralizedGravity(self.model, self.data, self.configuration(q_cols_rad, T))
+        out = np.zeros(len(JOINT_NAMES))
+        out[self._have] = g[self._v_of_col[self._have]]
+        return out
+
+    def com_m(self, q_cols_rad: np.ndarray, T_world_pelvis: np.ndarray) -> np.ndarray:
+        """Whole-body centre of mass in the world [m]."""
+        return np.array(pin.centerOfMass(self.model, self.data,
+                                         self.configuration(q_cols_rad, T_world_pelvis)))
+
+    # ------------------------------------------------------------------ kinematics
+    def frame_in_pelvis(self, q_cols_rad: np.ndarray, frame: str) -> np.ndarray:
+        """T_pelvis_frame (4, 4) at the given joint angles."""
+        return self.frames_in_pelvis(q_cols_rad, (frame,))[frame]
+
+    def frames_in_pelvis(self, q_cols_rad: np.ndarray, frames: tuple[str, ...]
+                         ) -> dict[str, np.ndarray]:
+        """T_pelvis_frame (4, 4) of each named frame, from one forward kinematics."""
+        pin.framesForwardKinematics(self.model, self.data, self.configuration(q_cols_rad))
+        return {f: self.data.oMf[self._frame_id[f]].homogeneous.copy() for f in frames}
+
+    def limb_correction(self, q_cols_rad: np.ndarray, chain: LimbChain,
+                        shift_pelvis_m: np.ndarray, turn_pelvis: np.ndarray | None = None,
+                        iterations: int = 20, damping: float = 1e-3
+                        ) -> tuple[np.ndarray, float]:
+        """Joint offsets of ``chain`` that move its end frame by ``shift_pelvis_m`` (pelvis
+        frame) and turn it by the rotation ``turn_pelvis`` (pelvis frame; none when None),
+        the rest of the body fixed.
+
+        Damped least squares on the chain's joints within their limits.
+
+        Returns:
+            ``(dq_cols_rad, residual_m)``: offsets by column (zero off the chain), and how
+            far the end frame stays from the shifted target [m].
+        """
+        m, d = self.model, self.data
+        fid = self._frame_id[chain.frame]
+        cols = np.array(chain.columns)
+        q_cols = np.asarray(q_cols_rad, dtype=float).copy()
+        T0 = self.frame_in_pelvis(q_cols, chain.frame)
+        R_target = T0[:3, :3] if turn_pelvis is None else turn_pelvis @ T0[:3, :3]
+        target = pin.SE3(R_target, T0[:3, 3] + np.asarray(shift_pelvis_m, dtype=float))
+        vcols = self._v_of_col[cols]
+        err = np.zeros(6)
+        for _ in range(iterations):
+            q = self.configuration(q_cols)
+            pin.framesForwardKinematics(m, d, q)
+            current = d.oMf[fid]
+            err[:3] = target.translation - current.translation
+            err[3:] = pin.log3(target.rotation @ current.rotation.T)
+            if np.linalg.norm(err[:3]) < 1e-4 and np.linalg.norm(err[3:]) < 1e-3:
+                break
+            J = pin.computeFrameJacobian(m, d, q, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+            Jc = J[:, vcols]
+            step = Jc.T @ np.linalg.solve(Jc @ Jc.T + damping * np.eye(6), err)
+            q_cols[cols] = np.clip(q_cols[cols] + step, self.lower_rad[cols],
+                                   self.upper_rad[cols])
+        dq = np.zeros(len(JOINT_NAMES))
+        dq[cols] = q_cols[cols] - np.asarray(q_cols_rad)[cols]
+        residual = float(np.linalg.norm(
+            target.translation - self.frame_in_pelvis(q_cols, chain.frame)[:3, 3]))
+        return dq, residual
