@@ -6,10 +6,10 @@ import enum
 import math
 from dataclasses import dataclass, field
 
-from execute.motion.estimator import EstimatorConfig
 from robot.errors import InputError
 
-__all__ = ["HoldingArmReference", "MotionConfig", "MotionConfigError", "default_config"]
+__all__ = ["EstimatorConfig", "HoldingArmReference", "MotionConfig", "MotionConfigError",
+           "default_config"]
 
 
 class MotionConfigError(InputError):
@@ -19,6 +19,19 @@ class MotionConfigError(InputError):
         self.field, self.value, self.allowed = field_name, value, allowed
         super().__init__(f"motion layer {field_name} = {value!r}: allowed "
                          f"[{allowed[0]:g}, {allowed[1]:g}]")
+
+
+@dataclass(frozen=True)
+class EstimatorConfig:
+    """Attributes:
+        foot_contact_on_n: foot F/T load above which a foot stands [N].
+        foot_contact_off_n: load below which it has lifted [N] (hysteresis).
+        tilt_filter_s: time constant of the accelerometer's low-pass filter [s].
+    """
+
+    foot_contact_on_n: float = 60.0
+    foot_contact_off_n: float = 25.0
+    tilt_filter_s: float = 0.05
 
 
 class HoldingArmReference(enum.Enum):

@@ -21,27 +21,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from execute.motion.config import EstimatorConfig
 from execute.motion.robot_model import MotionRobotModel
 from execute.motion.sensed_state import SensedState
 from robot.joints import FINGER_JOINTS, joint_indices
 
-__all__ = ["BodyEstimate", "EstimatorConfig", "StateEstimator"]
+__all__ = ["BodyEstimate", "StateEstimator"]
 
 SIDES = ("left", "right")
 _FRAMES = ("L_sole", "R_sole", "L_palm", "R_palm")
-
-
-@dataclass(frozen=True)
-class EstimatorConfig:
-    """Attributes:
-        foot_contact_on_n: foot F/T load above which a foot stands [N].
-        foot_contact_off_n: load below which it has lifted [N] (hysteresis).
-        tilt_filter_s: time constant of the accelerometer's low-pass filter [s].
-    """
-
-    foot_contact_on_n: float = 60.0
-    foot_contact_off_n: float = 25.0
-    tilt_filter_s: float = 0.05
 
 
 @dataclass(frozen=True, eq=False)

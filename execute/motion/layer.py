@@ -12,6 +12,8 @@ hubo-motion-rt and the thesis's operator did (thesis §4.3.4, §6.2):
   sideways), and closes again, up to ``grasp_retries`` times. If it still holds nothing
   the layer **stops**: the player stays paused, every verified grip is kept, and the
   climb ends with the reason. The weight never moves onto an unverified grasp;
+- **wrist-roll relief** of a gripping compliant arm (`execute.motion.wrist_relief`), from
+  its motor current;
 - **reach correction**: every verified grasp measures where its rail is
   (`execute.motion.ladder_estimate`); every later reach of a hand or a foot to a hold on
   the ladder is re-targeted by that estimate, by inverse kinematics on the limb's chain
@@ -40,6 +42,7 @@ from execute.motion.gravity_compensation import ArmGravityCompensation
 from execute.motion.ladder_estimate import LadderEstimate, RailObservation
 from execute.motion.robot_model import MotionRobotModel
 from execute.motion.sensed_state import SensedState
+from execute.motion.wrist_relief import WRIST_ROLL, WristRollRelief
 from execute.play.player import PlayerTick, TrajectoryPlayer
 from ladders.geometry import LadderGeometry
 from ladders.spec import LadderSpec
@@ -125,6 +128,8 @@ class MotionLayer:
                  if limb.endswith("_foot")}
         self.estimator = StateEstimator(self.model, soles, self.config.estimator)
         self.gravity = ArmGravityCompensation(self.model)
+        self.wrist_relief = WristRollRelief(robot)
+        self._last_now: float | None = None
         self.ladder = LadderEstimate(self.config.max_reach_correction_m,
                                      self.config.max_reach_correction_rad)
         n = len(trajectory_rad)
@@ -386,15 +391,19 @@ class MotionLayer:
         for side in self._open_fingers:
             ref[self._finger_cols[side]] = 0.0
         mode = tick.mode
-        if self.config.holding_arm_reference is HoldingArmReference.SENSED:
-            seg = self.sidecar.segments[int(self._segment_of_line[tick.line_index])]
-            for side in SIDES:
-                hold = seg.holds.get(f"{side}_hand")
-                cols = self._arm_cols[side]
-                if hold is not None and hold.target.startswith("rail") and tick.comply[cols].all():
-                    if mode is tick.mode:
-                        mode = tick.mode.copy()
-                    mode[cols] = RefMode.COMPLIANT
+        seg = self.sidecar.segments[int(self._segment_of_line[tick.line_index])]
+        dt = 0.0 if self._last_now is None else self._now - self._last_now
+        self._last_now = self._now
+        for side in SIDES:
+            hold = seg.holds.get(f"{side}_hand")
+            cols = self._arm_cols[side]
+            gripping = (hold is not None and hold.target.startswith("rail")
+                        and bool(tick.comply[cols].all()))
+            ref[WRIST_ROLL[side]] += self.wrist_relief.update(side, gripping, s.cur_a, dt)
+            if gripping and self.config.holding_arm_reference is HoldingArmReference.SENSED:
+                if mode is tick.mode:
+                    mode = tick.mode.copy()
+                mode[cols] = RefMode.COMPLIANT
         ff = tick.feedforward_nm
         if self.config.gravity_compensation:
             ff = self.gravity.feedforward_nm(ff, plan_rad, s.pos_rad, self.estimate.R_tilt)

@@ -2,8 +2,8 @@
 
 `SensedState.from_sample` reads one ``daemon.structs.STATE_DTYPE`` sample, the struct the
 daemon publishes on its ``state`` channel on the robot and in simulation alike: encoders
-(joints and fingers), joint velocities, the four F/T sensors, the three IMUs, which boards
-are powered and which joints comply. There is no other way into the motion layer, so it
+(joints and fingers), joint velocities, motor currents, the four F/T sensors, the three
+IMUs, which boards are powered and which joints comply. There is no other way into the motion layer, so it
 cannot see the simulator's ground truth, contacts or grip latch.
 """
 
@@ -32,6 +32,8 @@ class SensedState:
         ft: (4, 3) ``mx [N·m], my [N·m], fz [N]`` per sensor, ``daemon.structs.FT_NAMES``
             order (right foot, left foot, right hand, left hand).
         imu: (3, 6) ``ax, ay, az [m/s²], wx, wy, wz [rad/s]`` per IMU (body, feet).
+        ref_rad: the reference each board runs on, shape (40,).
+        cur_a: motor currents [A], shape (40,).
         active: the joint's board is powered, shape (40,) bool.
         comply: the joint runs in PWM mode, shape (40,) bool.
     """
@@ -41,6 +43,8 @@ class SensedState:
     vel_rad_s: np.ndarray
     ft: np.ndarray
     imu: np.ndarray
+    ref_rad: np.ndarray
+    cur_a: np.ndarray
     active: np.ndarray
     comply: np.ndarray
 
@@ -54,6 +58,7 @@ class SensedState:
         imu = np.stack([sample["imu"][k].tolist() for k in range(len(IMU_NAMES))])
         return cls(float(sample["time_s"]), np.array(sample["pos"], dtype=float),
                    np.array(sample["vel"], dtype=float), ft, imu,
+                   np.array(sample["ref"], dtype=float), np.array(sample["cur"], dtype=float),
                    np.array(sample["active"], dtype=bool), np.array(sample["comply"], dtype=bool))
 
     def foot_load_n(self, side: str) -> float:

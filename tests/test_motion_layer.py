@@ -1,0 +1,197 @@
+"""The motion layer: sensed state only, gravity compensation, grasp checks, re-reach, stop."""
+
+from __future__ import annotations
+
+import ast
+import dataclasses
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).parent / "fixtures"))
+
+from make_fixture import cached_reach_fixture  # noqa: E402
+
+from daemon.control_modes import RefMode  # noqa: E402
+from daemon.joint_control import JointController  # noqa: E402
+from daemon.pwm import default_drc_gains, feedforward_duty_pct  # noqa: E402
+from daemon.sim.board_model import BoardModel, PlacementError  # noqa: E402
+from daemon.structs import STATE_DTYPE, new_sample  # noqa: E402
+from execute.motion.config import MotionConfig, MotionConfigError  # noqa: E402
+from execute.motion.estimator import StateEstimator  # noqa: E402
+from execute.motion.grasp_check import GraspReading, read_grasp  # noqa: E402
+from execute.motion.ladder_estimate import LadderEstimate, RailObservation  # noqa: E402
+from execute.motion.robot_model import MotionRobotModel  # noqa: E402
+from execute.motion.sensed_state import SensedState  # noqa: E402
+from execute.validate.cli import main as validate_main  # noqa: E402
+from execute.validate.simulate import SimulationOptions, simulate  # noqa: E402
+from ladders.loader import load_ladder  # noqa: E402
+from robot.joints import ARM_JOINTS, FINGER_JOINTS, JOINT_INDEX, NUM_JOINTS  # noqa: E402
+from robot.kinematic_tree import FINGER_CLOSED_RAD  # noqa: E402
+from robot.params import robot_params  # noqa: E402
+from robot.plan_sidecar import read_sidecar, sidecar_path  # noqa: E402
+from robot.trajectory_file import read_trajectory  # noqa: E402
+
+MOTION_DIR = Path(__file__).parent.parent / "execute" / "motion"
+
+
+@pytest.fixture(scope="module")
+def reach(tmp_path_factory):
+    path = cached_reach_fixture(tmp_path_factory.getbasetemp())
+    sc = read_sidecar(sidecar_path(path))
+    return path, read_trajectory(path, sc.rate_hz), sc, load_ladder("drc")
+
+
+def test_the_layer_reads_no_simulator_state():
+    """Nothing in the motion layer can reach MuJoCo, the board model or the grip latch:
+    its modules import neither, and its only input is the daemon's state struct."""
+    banned = ("mujoco", "daemon.sim", "daemon.board", "grasp_latch")
+    for path in MOTION_DIR.glob("*.py"):
+        tree = ast.parse(path.read_text())
+        for node in ast.walk(tree):
+            names = []
+            if isinstance(node, ast.Import):
+                names = [a.name for a in node.names]
+            elif isinstance(node, ast.ImportFrom):
+                names = [node.module or ""]
+            for name in names:
+                assert not any(name.startswith(b) or b in name for b in banned), (path, name)
+
+
+def test_the_estimator_runs_on_the_state_struct_alone():
+    """A hand-made state sample (no simulator anywhere): the robot standing in its zero
+    pose, each foot carrying half its weight, fingers closed on a 25 mm rail."""
+    model = MotionRobotModel()
+    sample = new_sample(STATE_DTYPE)
+    sample["time_s"] = 1.0
+    fingers = [JOINT_INDEX[f] for f in FINGER_JOINTS["left"]]
+    sample["pos"][fingers] = 0.09
+    sample["imu"][0]["az"] = 9.81
+    for k in (0, 1):
+        sample["ft"][k]["fz"] = 0.5 * model.mass_kg * 9.81
+    soles = {"left": np.array([0.0, 0.0885, 0.0]), "right": np.array([0.0, -0.0885, 0.0])}
+    est = StateEstimator(model, soles).update(SensedState.from_sample(sample))
+    assert est.standing == {"left": True, "right": True}
+    assert np.allclose(est.sole_m["left"], soles["left"], atol=1e-6)
+    assert est.T_world_pelvis[2, 3] == pytest.approx(robot_params().pelvis_height_m, abs=0.02)
+    assert est.finger_curl_rad["left"] == pytest.approx(0.09)
+    assert np.allclose(est.R_tilt, np.eye(3))
+    s = SensedState.from_sample(sample)
+    assert read_grasp("left", s.pos_rad, s.vel_rad_s) is GraspReading.ON_RAIL
+    sample["pos"][fingers] = FINGER_CLOSED_RAD
+    s = SensedState.from_sample(sample)
+    assert read_grasp("left", s.pos_rad, s.vel_rad_s) is GraspReading.EMPTY
+    with pytest.raises(TypeError):
+        SensedState.from_sample(np.zeros(3))
+
+
+def test_the_ladder_estimate_recovers_shift_and_yaw():
+    est = LadderEstimate(max_shift_m=0.1, max_yaw_rad=0.3)
+    up = np.array([0.5, 0.0, np.sqrt(3) / 2])
+    true_shift, yaw, centre = np.array([0.02, -0.01, 0.0]), 0.03, np.zeros(3)
+    for rail, y in (("rail_left", 0.675), ("rail_right", -0.675)):
+        for height in (1.0, 1.3):
+            p = np.array([0.2 + 0.5 * height, y, height])
+            moved = p + true_shift + yaw * np.cross([0, 0, 1], p - centre)
+            est.add(RailObservation(f"{rail}{height}", p, moved, up))
+    p = np.array([0.9, 0.675, 1.6])
+    want = true_shift + yaw * np.cross([0, 0, 1], p - centre)
+    got = est.correction_m(p)
+    across = np.eye(3) - np.outer(up, up)  # along the rail, nothing is observable
+    assert np.linalg.norm(across @ (got - want)) < 0.003
+    assert est.yaw_rad == pytest.approx(yaw, abs=0.005)
+
+
+@pytest.mark.parametrize("field,value", [("max_reach_correction_m", 0.2),
+                                         ("grasp_retries", -1),
+                                         ("max_reach_correction_rad", 1.0)])
+def test_unsafe_settings_are_refused(field, value):
+    with pytest.raises(MotionConfigError) as exc:
+        MotionConfig(**{field: value})
+    assert exc.value.field == field and field in str(exc.value)
+
+
+def test_cli_refuses_a_reach_bound_beyond_the_safe_range(reach, capsys):
+    path = reach[0]
+    assert validate_main([str(path), "--max-reach-correction", "0.5"]) == 2
+    err = capsys.readouterr().err
+    assert "max_reach_correction_m" in err and "[0, 0.1]" in err
+
+
+def _arm_drift_rad(compensated: bool) -> float:
+    """A PWM left arm, elbow bent forward (every joint's gravity torque within its PWM
+    clamp), in mode COMPLIANT (reference on the encoders, the
+    thesis's default gravity-compensation mode), with or without the model's gravity
+    torques as feed-forward; how far it moves in 2 s [rad]."""
+    board = BoardModel(dataclasses.replace(load_ladder("drc"), placement_x_m=3.0))
+    q = np.zeros(NUM_JOINTS)
+    arm = [JOINT_INDEX[n] for n in ARM_JOINTS["left"]]
+    q[JOINT_INDEX["LSP"]], q[JOINT_INDEX["LSR"]], q[JOINT_INDEX["LEB"]] = -0.2, 0.3, -0.6
+    board.reset(q)
+    model = MotionRobotModel()
+    ctl, gains = JointController(), default_drc_gains()
+    comply = np.zeros(NUM_JOINTS, dtype=bool)
+    comply[arm] = True
+    mode = np.full(NUM_JOINTS, int(RefMode.FILTER), dtype=np.int8)
+    mode[arm] = RefMode.COMPLIANT
+    mode[JOINT_INDEX["LWR"]] = RefMode.FILTER  # the wrist roll cannot comply: held rigid
+    start = board.joint_pos()[arm]
+    for _ in range(400):
+        pos = board.joint_pos()
+        ff = None
+        if compensated:
+            torque = np.zeros(NUM_JOINTS)
+            torque[arm] = model.gravity_torques(pos, np.eye(3))[arm]
+            ff = feedforward_duty_pct(torque, board.config.battery_v, None, board.motors)
+        board.apply(ctl.tick(q, mode, comply, pos, board.joint_vel(), gains, ff))
+        board.step()
+    return float(np.max(np.abs(board.joint_pos()[arm] - start)))
+
+
+def test_gravity_compensation_holds_a_pwm_arm_still():
+    held, sagged = _arm_drift_rad(True), _arm_drift_rad(False)
+    assert held < 0.02
+    assert sagged > 0.1
+
+
+def test_a_misplaced_ladder_is_re_grasped_from_sensors(reach):
+    """The ladder 4.5 cm further than planned: open loop the first grasp misses; closed
+    loop the fingers read empty, the hand re-reaches and both hands hold."""
+    _path, traj, sc, ladder = reach
+    placement = PlacementError(0.045, 0.0, 0.0)
+    opened = simulate(traj, sc, ladder, SimulationOptions(
+        placement=placement, record_qpos=False, closed_loop=False))
+    assert opened.verdict.failure.cause == "grasp_not_latched"
+    closed = simulate(traj, sc, ladder, SimulationOptions(placement=placement,
+                                                          record_qpos=False))
+    assert closed.verdict.climbed, closed.verdict
+    kinds = [e["kind"] for e in closed.motion["events"]]
+    assert "grasp missed" in kinds and kinds.count("grasp verified") == 2
+    assert "re-reach" in kinds or "reach correction" in kinds
+    # the estimate found the ladder further away: across the rails, towards the ladder
+    assert closed.motion["ladder_shift_m"][0] > 0.01
+
+
+def test_an_unrecoverable_miss_holds_with_no_weight_shift(reach, tmp_path):
+    """Rails 11.5 cm beyond the closing palms, out of the search's reach: the layer stops
+    at the grasp, the player never moves on to the lines that load the hands, and the
+    feet still carry the robot."""
+    path, traj, sc, ladder = reach
+    run = simulate(traj, sc, ladder, SimulationOptions(
+        placement=PlacementError(0.115, 0.0, 0.0), record_qpos=False))
+    f = run.verdict.failure
+    assert f.cause == "grasp_unverified" and f.details["tries"] >= 1
+    grasp = next(s for s in sc.segments if s.phase == "grasp")
+    assert run.log.line_index.max() <= grasp.last_line - 1
+    assert not run.log.latched.any()
+    stop = run.motion["stop"]
+    assert stop is not None and "not moved onto it" in stop["reason"]
+    # held still after stopping: the pelvis did not move in the last second
+    com = run.log.com_m
+    last = run.log.time_s > run.log.time_s[-1] - 1.0
+    assert np.ptp(com[last], axis=0).max() < 0.005
+    code = validate_main([str(path), "--placement-error", "0.115,0,0",
+                          "--json", str(tmp_path / "r.json")])
+    assert code == 1
