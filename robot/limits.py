@@ -11,6 +11,11 @@ from robot.joints import JOINT_NAMES
 from robot.kinematic_tree import build_tree
 from robot.params import RobotParams, robot_params
 
+#: How far beyond a joint limit a value still counts as on it [rad]: the float slack of
+#: values written by a formatter. The trajectory reader accepts such values and the
+#: daemon clamps them; anything farther is refused (reader) or rejected (daemon).
+LIMIT_TOLERANCE_RAD = 1e-9
+
 
 @dataclass(frozen=True)
 class JointLimits:

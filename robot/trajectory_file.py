@@ -10,19 +10,83 @@ from __future__ import annotations
 
 import math
 import os
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from robot.errors import TrajectoryFileError
+from robot.errors import InputError, TrajectoryFileError
 from robot.joints import JOINT_NAMES, NUM_JOINTS
-from robot.limits import joint_limits
+from robot.limits import LIMIT_TOLERANCE_RAD, joint_limits
+
+__all__ = [
+    "LIMIT_TOLERANCE_RAD",
+    "MAX_CLAMP_TOLERANCE_RAD",
+    "MAX_LINE_CHARS",
+    "ClampedJoint",
+    "format_clamps",
+    "format_trajectory",
+    "parse_trajectory",
+    "read_trajectory",
+    "read_trajectory_clamped",
+    "write_trajectory",
+]
 
 #: fgets(buf, 1000) reads at most 999 bytes including the newline: a longer line was
 #: split in two and silently misread by the original player.
 MAX_LINE_CHARS = 998
-#: Tolerance on the joint limits for values written by a float formatter [rad].
-LIMIT_TOLERANCE_RAD = 1e-9
+#: The largest ``--clamp-limits`` tolerance [rad]: files of the original player overshoot
+#: the knee's lower limit by up to 0.07 rad; a larger tolerance would hide real errors.
+MAX_CLAMP_TOLERANCE_RAD = 0.1
+
+
+@dataclass(frozen=True)
+class ClampedJoint:
+    """What ``--clamp-limits`` changed on one joint of a file.
+
+    Attributes:
+        joint: the joint (column name).
+        lines: the 1-based lines whose value was moved onto the limit.
+        max_overshoot_rad: the largest distance beyond the limit [rad].
+        worst_line: the line of that largest overshoot.
+        worst_value_rad: the value found there [rad].
+        limit_rad: the limit it was clamped to [rad].
+    """
+
+    joint: str
+    lines: tuple[int, ...]
+    max_overshoot_rad: float
+    worst_line: int
+    worst_value_rad: float
+    limit_rad: float
+
+    def __str__(self) -> str:
+        side = "below its lower" if self.worst_value_rad < self.limit_rad else "above its upper"
+        n = len(self.lines)
+        return (f"{self.joint}: {n} line{'s' if n != 1 else ''} clamped ({_ranges(self.lines)}); "
+                f"largest overshoot {self.max_overshoot_rad:.4g} rad at line "
+                f"{self.worst_line} ({self.worst_value_rad:.6g} rad, {side} limit "
+                f"{self.limit_rad:.4g} rad)")
+
+
+def _ranges(lines: tuple[int, ...], most: int = 6) -> str:
+    """``3-9, 40-44, 51`` for sorted line numbers; the first ``most`` runs."""
+    runs: list[list[int]] = []
+    for n in lines:
+        if runs and n == runs[-1][1] + 1:
+            runs[-1][1] = n
+        else:
+            runs.append([n, n])
+    shown = [f"{a}" if a == b else f"{a}-{b}" for a, b in runs[:most]]
+    more = f", ... {len(runs) - most} more run(s)" if len(runs) > most else ""
+    return ("line " if len(lines) == 1 else "lines ") + ", ".join(shown) + more
+
+
+def format_clamps(source: str, clamps: tuple[ClampedJoint, ...], tol_rad: float) -> str:
+    """The per-joint report of a clamped read, one line per joint."""
+    head = (f"{source}: --clamp-limits {tol_rad:g} rad: {sum(len(c.lines) for c in clamps)} "
+            f"value(s) on {len(clamps)} joint(s) moved onto their limit")
+    return "\n".join([head] + [f"  {c}" for c in clamps])
 
 
 def format_trajectory(q_rad: np.ndarray) -> str:
@@ -81,7 +145,26 @@ def parse_trajectory(text: str, source: str, rate_hz: float, robot: str = "drc-h
     Raises:
         TrajectoryFileError: with every problem found, as ``source:line:column: message``.
     """
+    return _parse(text, source, rate_hz, robot, check_speed, 0.0)[0]
+
+
+def _check_clamp_tolerance(tol_rad: float) -> float:
+    try:
+        tol = float(tol_rad)
+    except (TypeError, ValueError):
+        tol = math.nan
+    if not (math.isfinite(tol) and 0.0 <= tol <= MAX_CLAMP_TOLERANCE_RAD):
+        raise InputError(f"--clamp-limits {tol_rad}: allowed 0 to {MAX_CLAMP_TOLERANCE_RAD:g} "
+                         "rad")
+    return tol
+
+
+def _parse(text: str, source: str, rate_hz: float, robot: str, check_speed: bool,
+           clamp_tol_rad: float) -> tuple[np.ndarray, tuple[ClampedJoint, ...]]:
+    """`parse_trajectory`, clamping values within ``clamp_tol_rad`` beyond a limit."""
     limits = joint_limits(robot)
+    tol = max(LIMIT_TOLERANCE_RAD, clamp_tol_rad)
+    clamped: dict[int, list[tuple[int, float, float, float]]] = {}
     problems: list[str] = []
     rows: list[np.ndarray] = []
     row_lines: list[int] = []
@@ -120,10 +203,17 @@ def parse_trajectory(text: str, source: str, rate_hz: float, robot: str = "drc-h
                 ok = False
                 continue
             lo, hi = limits.lower_rad[k], limits.upper_rad[k]
-            if v < lo - LIMIT_TOLERANCE_RAD or v > hi + LIMIT_TOLERANCE_RAD:
+            if v < lo - tol or v > hi + tol:
+                hint = "" if tol <= LIMIT_TOLERANCE_RAD else \
+                    f" by more than the --clamp-limits tolerance {clamp_tol_rad:g} rad"
                 problems.append(f"{where}:{col}: column {k + 1} ({JOINT_NAMES[k]}): {v:.6g} rad "
-                                f"is outside the joint limits [{lo:.4g}, {hi:.4g}] rad")
+                                f"is outside the joint limits [{lo:.4g}, {hi:.4g}] rad{hint}")
                 ok = False
+            elif clamp_tol_rad > 0.0 and (v < lo - LIMIT_TOLERANCE_RAD
+                                          or v > hi + LIMIT_TOLERANCE_RAD):
+                limit = lo if v < lo else hi
+                clamped.setdefault(k, []).append((lineno, abs(v - limit), v, limit))
+                v = limit
             values[k] = v
         if ok and len(tokens) != NUM_JOINTS:
             col = tokens[-1][0] if len(tokens) < NUM_JOINTS else tokens[NUM_JOINTS][0]
@@ -145,12 +235,48 @@ def parse_trajectory(text: str, source: str, rate_hz: float, robot: str = "drc-h
                 f"{limits.velocity_max_rad_s[k]:g} rad/s")
     if problems:
         raise TrajectoryFileError(source, problems)
-    return np.vstack(rows)
+    report = []
+    for k in sorted(clamped):
+        entries = clamped[k]
+        worst = max(entries, key=lambda e: e[1])
+        report.append(ClampedJoint(JOINT_NAMES[k], tuple(e[0] for e in entries),
+                                   float(worst[1]), worst[0], float(worst[2]),
+                                   float(worst[3])))
+    return np.vstack(rows), tuple(report)
 
 
 def read_trajectory(path: str | os.PathLike, rate_hz: float, robot: str = "drc-hubo",
                     check_speed: bool = True) -> np.ndarray:
     """Read and validate a 40-column file; see ``parse_trajectory``."""
+    return _parse(_read_text(path), str(path), rate_hz, robot, check_speed, 0.0)[0]
+
+
+def read_trajectory_clamped(path: str | os.PathLike, rate_hz: float, clamp_tol_rad: float,
+                            robot: str = "drc-hubo", check_speed: bool = True
+                            ) -> tuple[np.ndarray, tuple[ClampedJoint, ...]]:
+    """Read a 40-column file, moving values at most ``clamp_tol_rad`` beyond a joint limit
+    onto that limit (``play-trajectory --clamp-limits``); farther ones are refused as by
+    `read_trajectory`. The speed check runs on the clamped values.
+
+    Args:
+        path: the file.
+        rate_hz: playback rate [Hz].
+        clamp_tol_rad: the tolerance [rad], 0 to `MAX_CLAMP_TOLERANCE_RAD` (0: strict).
+        robot: robot whose limits apply.
+        check_speed: also refuse steps faster than each joint's maximum speed.
+
+    Returns:
+        The (N, 40) array [rad] and, per joint that was clamped, a `ClampedJoint`.
+
+    Raises:
+        InputError: a tolerance outside its range.
+        TrajectoryFileError: every problem found, as ``file:line:column: message``.
+    """
+    tol = _check_clamp_tolerance(clamp_tol_rad)
+    return _parse(_read_text(path), str(path), rate_hz, robot, check_speed, tol)
+
+
+def _read_text(path: str | os.PathLike) -> str:
     path = Path(path)
     try:
         raw = path.read_bytes()
@@ -161,4 +287,4 @@ def read_trajectory(path: str | os.PathLike, rate_hz: float, robot: str = "drc-h
     except UnicodeDecodeError as exc:
         line = raw[: exc.start].count(b"\n") + 1
         raise TrajectoryFileError(str(path), [f"{path}:{line}: non-ASCII byte"]) from None
-    return parse_trajectory(text, str(path), rate_hz, robot, check_speed)
+    return text

@@ -3,10 +3,16 @@
 import numpy as np
 import pytest
 
-from robot.errors import TrajectoryFileError
-from robot.joints import JOINT_NAMES
+from robot.errors import InputError, TrajectoryFileError
+from robot.joints import JOINT_INDEX, JOINT_NAMES
 from robot.limits import joint_limits
-from robot.trajectory_file import format_trajectory, read_trajectory, write_trajectory
+from robot.trajectory_file import (
+    format_clamps,
+    format_trajectory,
+    read_trajectory,
+    read_trajectory_clamped,
+    write_trajectory,
+)
 
 
 def _smooth_trajectory(n=50, seed=3):
@@ -113,3 +119,60 @@ def test_empty_and_missing_files(tmp_path):
     empty.write_text("")
     assert "no trajectory lines" in _fail(empty)
     assert "cannot read" in _fail(tmp_path / "missing.traj")
+
+
+# --clamp-limits: real files of the original player overshoot the knee's 0 lower limit.
+def _real_style(tmp_path, right_knee_min, name="squat.traj"):
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).parent))
+    from real_style_traj import real_style_rows, write_real_style
+
+    rows = real_style_rows(knee_min_rad=(right_knee_min, -0.0004))
+    return write_real_style(tmp_path / name, rows), rows
+
+
+def test_real_style_overshoot_is_refused_by_default(tmp_path):
+    path, _ = _real_style(tmp_path, -0.07)
+    with pytest.raises(TrajectoryFileError) as err:
+        read_trajectory(path, 25.0)
+    msg = "\n".join(err.value.problems)
+    assert "column 4 (RKN): -0.07 rad is outside the joint limits [0, 2.61] rad" in msg
+    assert "squat.traj:60:" in msg and "(LKN): -0.0004 rad" in msg
+
+
+def test_clamp_limits_moves_small_overshoots_onto_the_limit_and_reports_them(tmp_path):
+    path, _ = _real_style(tmp_path, -0.07)
+    rows = np.loadtxt(path)  # the values as written (6 decimals)
+    q, clamps = read_trajectory_clamped(path, 25.0, 0.1)
+    lo = joint_limits("drc-hubo").lower_rad
+    assert (q >= lo).all()
+    beyond = rows < lo
+    assert np.array_equal(q[~beyond], rows[~beyond])  # nothing else changed
+    by_joint = {c.joint: c for c in clamps}
+    assert sorted(by_joint) == ["LKN", "RKN"]
+    rkn = by_joint["RKN"]
+    assert rkn.lines == tuple(int(k) + 1 for k in np.flatnonzero(beyond[:, JOINT_INDEX["RKN"]]))
+    assert rkn.max_overshoot_rad == pytest.approx(0.07) and rkn.worst_line == 60
+    assert by_joint["LKN"].max_overshoot_rad == pytest.approx(0.0004)
+    report = format_clamps(str(path), clamps, 0.1)
+    assert "RKN:" in report and "largest overshoot 0.07 rad at line 60" in report
+    assert "below its lower limit 0 rad" in report
+
+
+def test_clamp_limits_still_refuses_beyond_the_tolerance(tmp_path):
+    path, _ = _real_style(tmp_path, -0.07)
+    with pytest.raises(TrajectoryFileError) as err:
+        read_trajectory_clamped(path, 25.0, 0.01)
+    msg = "\n".join(err.value.problems)
+    assert "-0.07 rad is outside the joint limits [0, 2.61] rad by more than the " \
+           "--clamp-limits tolerance 0.01 rad" in msg
+    assert "(LKN)" not in msg  # -0.0004 is within 0.01: clamped, not refused
+
+
+@pytest.mark.parametrize("tol", [-0.01, 0.5, float("nan")])
+def test_clamp_tolerance_outside_its_range_is_refused(tmp_path, tol):
+    path, _ = _real_style(tmp_path, -0.07)
+    with pytest.raises(InputError, match="--clamp-limits .*allowed 0 to 0.1 rad"):
+        read_trajectory_clamped(path, 25.0, tol)
