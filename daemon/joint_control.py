@@ -11,7 +11,12 @@ control law, per joint:
 
 One tick, per joint, as hubo-ach did it:
 
-1. The commanded reference is clamped into the joint limits of the robot description.
+1. A commanded reference outside the joint limits of the robot description (by more than
+   `robot.limits.LIMIT_TOLERANCE_RAD`) is rejected: that joint keeps its previous
+   accepted reference, and :attr:`ControlOutput.limit_rejected` names it. hubo-ach
+   clamped it instead, which moved the joint to its limit: a ``goto RKN 3.0`` drove the
+   knee to 2.61 rad, and the simulated robot fell. Values within the tolerance (float
+   slack) are clamped.
 2. The sent reference ``f`` is filtered by the joint's reference mode
    (``daemon.control_modes``).
 3. Compliance:
@@ -43,7 +48,7 @@ No I/O, no clock, numpy only.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from enum import IntEnum
 
 import numpy as np
@@ -59,7 +64,7 @@ from daemon.control_modes import (
 from daemon.pwm import PwmGains, pwm_duty
 from robot.errors import InputError
 from robot.joints import ARM_JOINTS, FINGER_JOINTS, JOINT_INDEX, JOINT_NAMES, NUM_JOINTS
-from robot.limits import JointLimits, joint_limits
+from robot.limits import LIMIT_TOLERANCE_RAD, JointLimits, joint_limits
 from robot.pwm_gains import PWM_COMMAND_LIMIT_PCT
 
 __all__ = [
@@ -120,7 +125,10 @@ class ControlOutput:
         returning: rigid return in progress (position mode, L = 400).
         limp: PWM joint whose gains are all zero, or whose max_pwm is 0.
         duty_saturated: the ±max_pwm clamp acted.
-        limit_clamped: the commanded or sent reference was outside the joint limits.
+        limit_rejected: the commanded reference was outside the joint limits; the joint
+            kept its previous accepted reference.
+        limit_clamped: the sent reference was outside the joint limits and was clamped
+            (encoder-following modes, float slack of the commanded reference).
         comply_unsupported: comply requested on a joint that cannot comply.
         state: :class:`ComplianceState` per joint after this tick (int8).
     """
@@ -134,6 +142,7 @@ class ControlOutput:
     limit_clamped: np.ndarray
     comply_unsupported: np.ndarray
     state: np.ndarray
+    limit_rejected: np.ndarray = field(default_factory=lambda: np.zeros(NUM_JOINTS, bool))
 
     def __repr__(self) -> str:
         def names(mask: np.ndarray) -> str:
@@ -142,7 +151,8 @@ class ControlOutput:
         return (
             f"ControlOutput(pwm={names(self.pwm)} returning={names(self.returning)} "
             f"limp={names(self.limp)} saturated={names(self.duty_saturated)} "
-            f"clamped={names(self.limit_clamped)})"
+            f"clamped={names(self.limit_clamped)} "
+            f"rejected={names(self.limit_rejected)})"
         )
 
 
@@ -184,6 +194,7 @@ class JointController:
         self.compliance_capable = np.array(capable, dtype=bool)
         self.compliance_capable.setflags(write=False)
         self._sent_rad: np.ndarray | None = None
+        self._ref_rad: np.ndarray | None = None  # last accepted commanded reference
         self._state = np.zeros(NUM_JOINTS, dtype=np.int8)
 
     def reset(self, pos_rad: np.ndarray) -> None:
@@ -194,6 +205,7 @@ class JointController:
         """
         pos = _vector("pos_rad", pos_rad)
         self._sent_rad = clamp_reference(pos, self.limits.lower_rad, self.limits.upper_rad)[0]
+        self._ref_rad = self._sent_rad.copy()
         self._state[:] = ComplianceState.RIGID
 
     @property
@@ -254,7 +266,11 @@ class JointController:
         if self._sent_rad is None:
             self.reset(pos)
         lower, upper = self.limits.lower_rad, self.limits.upper_rad
-        ref, ref_clamped = clamp_reference(ref_in, lower, upper)
+        rejected = (ref_in < lower - LIMIT_TOLERANCE_RAD) | (ref_in > upper + LIMIT_TOLERANCE_RAD)
+        ref, ref_clamped = clamp_reference(np.where(rejected, self._ref_rad, ref_in), lower,
+                                           upper)
+        ref_clamped &= ~rejected
+        self._ref_rad = ref
         prev = self._sent_rad
         state = self._state
 
@@ -293,4 +309,5 @@ class JointController:
             limit_clamped=ref_clamped | sent_clamped,
             comply_unsupported=comply & ~self.compliance_capable,
             state=new_state.copy(),
+            limit_rejected=rejected,
         )

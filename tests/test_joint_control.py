@@ -59,14 +59,34 @@ def test_filter_mode_ticks_by_hand():
     assert (out.state == ComplianceState.RIGID).all()
 
 
-def test_direct_mode_and_limit_clamp_of_the_sent_reference():
+def test_a_reference_beyond_a_limit_is_rejected_and_the_previous_one_held():
+    c = JointController()
+    c.reset(ZERO)
+    ref = np.zeros(N)
+    ref[J["REB"]] = -0.4
+    ref[J["RSP"]] = 0.3
+    c.tick(ref, RefMode.DIRECT, RIGID, ZERO, ZERO, default_drc_gains())
+    ref[J["REB"]] = 0.5  # upper limit 0: rejected, REB keeps -0.4
+    ref[J["RKN"]] = 3.0  # upper limit 2.61: rejected, RKN keeps 0
+    ref[J["RSP"]] = 0.2
+    out = c.tick(ref, RefMode.DIRECT, RIGID, ZERO, ZERO, default_drc_gains())
+    assert out.ref_sent_rad[J["REB"]] == -0.4 and out.ref_sent_rad[J["RKN"]] == 0.0
+    assert out.ref_sent_rad[J["RSP"]] == 0.2  # the other joints of the sample are followed
+    assert np.flatnonzero(out.limit_rejected).tolist() == sorted([J["REB"], J["RKN"]])
+    assert not out.limit_clamped.any()
+    ref[J["REB"]], ref[J["RKN"]] = -0.1, 1.0  # back within the limits: followed again
+    out = c.tick(ref, RefMode.DIRECT, RIGID, ZERO, ZERO, default_drc_gains())
+    assert out.ref_sent_rad[J["REB"]] == -0.1 and out.ref_sent_rad[J["RKN"]] == 1.0
+    assert not out.limit_rejected.any()
+
+
+def test_float_slack_at_a_limit_is_clamped_not_rejected():
     c = JointController()
     ref = np.zeros(N)
-    ref[J["REB"]] = 0.5  # upper limit 0
-    ref[J["RSP"]] = 0.3
+    ref[J["RKN"]] = -1e-10  # lower limit 0, within LIMIT_TOLERANCE_RAD
     out = c.tick(ref, RefMode.DIRECT, RIGID, ZERO, ZERO, default_drc_gains())
-    assert out.ref_sent_rad[J["REB"]] == 0.0 and out.limit_clamped[J["REB"]]
-    assert out.ref_sent_rad[J["RSP"]] == 0.3 and not out.limit_clamped[J["RSP"]]
+    assert out.ref_sent_rad[J["RKN"]] == 0.0 and out.limit_clamped[J["RKN"]]
+    assert not out.limit_rejected.any()
 
 
 def test_encoder_following_modes_are_clamped_too():
