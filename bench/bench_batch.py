@@ -1,6 +1,6 @@
 """Benchmark: batch-eval throughput in jobs per core-minute.
 
-Workloads (each through the real runner, `execute.batch_runner.run_batch`):
+Workloads (each through the real runner, `execute.batch.runner.run_batch`):
 
 1. **real, small** (default): the stair ladder up to its first rung, 2 seeds × 3
    strategies with ``placement=0.03`` on a local pool of 2 workers: 2 real plans
@@ -35,10 +35,10 @@ def _throughput(n_jobs: int, wall_s: float, workers: int) -> float:
 
 
 def run() -> list[dict]:
-    from execute.batch_engine import dask_engine, local_engine
-    from execute.batch_jobs import JobFunctions, expand_jobs
-    from execute.batch_perturb import parse_perturb
-    from execute.batch_runner import run_batch
+    from execute.batch.engine import dask_engine, local_engine
+    from execute.batch.jobs import JobFunctions, expand_jobs
+    from execute.batch.perturb import parse_perturb
+    from execute.batch.runner import run_batch
     from ladders.loader import load_ladder
 
     workers = max(1, min(WORKERS, os.cpu_count() or 1))

@@ -1,4 +1,4 @@
-"""Benchmark: encode + decode of one whole 5 ms CAN cycle (`daemon.can_protocol.CyclePlan`).
+"""Benchmark: encode + decode of one whole 5 ms CAN cycle (`daemon.can.protocol.CyclePlan`).
 
 Per cycle: the reference frames and requests of both buses are encoded from 40 joint
 references, and a full set of replies (encoder, FT, tilt/IMU, power) is decoded into
@@ -21,7 +21,7 @@ CYCLE_TARGET_MS = 0.5
 
 
 def _replies(plan, ref_rad: np.ndarray) -> dict[int, list]:
-    from daemon import can_protocol as cp
+    from daemon.can import protocol as cp
 
     rx: dict[int, list] = {b: [] for b in plan.buses}
     for b, msgs in plan.encode(ref_rad).items():
@@ -44,7 +44,7 @@ def _replies(plan, ref_rad: np.ndarray) -> dict[int, list]:
 
 def measure_cycle(n: int = 2000) -> tuple[np.ndarray, object]:
     """Per-cycle encode + decode times [ms] over ``n`` cycles, and the plan."""
-    from daemon.can_protocol import CyclePlan
+    from daemon.can.protocol import CyclePlan
     from daemon.tables import load_joint_table, load_sensor_table
 
     plan = CyclePlan(load_joint_table(), load_sensor_table())

@@ -7,8 +7,8 @@ between consecutive ticks; an overrun shows as a large error (its skipped deadli
 also counted). Cases:
 
 - ``sim``: the MuJoCo board model on the DRC ladder (two 2.5 ms physics steps a tick);
-- ``virtual CAN``: `daemon.backend_can.CanBackend` on python-can ``virtual`` buses with
-  `daemon.board_emulator.BoardEmulator` answering from threads of the same process (the
+- ``virtual CAN``: `daemon.can.backend.CanBackend` on python-can ``virtual`` buses with
+  `daemon.can.emulator.BoardEmulator` answering from threads of the same process (the
   virtual interface does not cross processes), so the emulator's work shares the GIL;
 
 each with normal scheduling (as ``hubo-daemon`` runs by default) and, where the process
@@ -51,13 +51,13 @@ def _measure(kind: str, seconds: float, rt: bool) -> tuple[np.ndarray, int] | No
     emu = None
     old_switch = sys.getswitchinterval()
     if kind == "sim":
-        from daemon.backend_sim import SimBackend
+        from daemon.sim.backend import SimBackend
         from ladders.loader import load_ladder
 
         backend = SimBackend(load_ladder("drc"), homed=True)
     else:
-        from daemon.backend_can import CanBackend
-        from daemon.board_emulator import BoardEmulator
+        from daemon.can.backend import CanBackend
+        from daemon.can.emulator import BoardEmulator
         from daemon.tables import load_joint_table, load_sensor_table
 
         chans = (f"{instance}-0", f"{instance}-1")

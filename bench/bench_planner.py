@@ -21,7 +21,7 @@ import statistics
 import time
 from pathlib import Path
 
-from planner.arm_capacity import DEFAULT_ARM_STRATEGY
+from planner.statics.arm_capacity import DEFAULT_ARM_STRATEGY
 
 TARGET_PER_RUNG_S = 5.0
 TARGET_LADDER_S = 60.0
@@ -108,8 +108,8 @@ def run(full: bool | None = None) -> list[dict]:
 
 def _random_ladders() -> list[dict]:
     """How many of the random ladders plan, per arm strategy."""
-    from execute.batch_sweep import load_sweep
-    from planner.arm_capacity import ARM_STRATEGIES
+    from execute.batch.sweep import load_sweep
+    from planner.statics.arm_capacity import ARM_STRATEGIES
 
     cells = load_sweep(RANDOM_LADDERS)
     out = []

@@ -39,7 +39,7 @@ def _drc_plan(tmp: str) -> Path:
 
 def run() -> list[dict]:
     """Time one simulated climb per strategy; report simulated s / wall s."""
-    from execute.simulate import SimulationOptions, simulate
+    from execute.validate.simulate import SimulationOptions, simulate
     from ladders.spec import LadderSpec
     from robot.plan_sidecar import read_sidecar, sidecar_path
     from robot.trajectory_file import read_trajectory
@@ -52,7 +52,7 @@ def run() -> list[dict]:
         sc = read_sidecar(sidecar_path(plan))
         traj = read_trajectory(plan, sc.rate_hz, sc.robot)
         if "geometry" in sc.ladder:
-            from execute.validate_cli import ladder_from_sidecar
+            from execute.validate.cli import ladder_from_sidecar
             ladder = ladder_from_sidecar(sc.ladder, str(plan))
         else:
             ladder = LadderSpec(**sc.ladder)

@@ -1,4 +1,10 @@
-"""The daemon side: per-joint control law (and, alongside, channels and backends).
+"""The daemon side: per-joint control law, the 200 Hz loop, channels and backends.
+
+- here: channel structs (`structs`), latest-value channels (`channels`), the control law
+  (`control_modes`, `joint_control`, `pwm`), the loop (`loop`), joint/sensor tables
+  (`tables`), the state log, and the ``hubo-daemon``, ``hubo-console``, ``hubo-read`` CLIs;
+- `daemon.can`: the CAN protocol, backend and board emulator;
+- `daemon.sim`: the MuJoCo board model and the simulated world (grip, sensors, trips).
 
 Re-exports only light, numpy-only names; backends (MuJoCo, CAN) are imported from their
 own modules when needed.

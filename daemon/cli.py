@@ -12,7 +12,7 @@ after its current tick, the boards keep the last reference (position held), the 
 flushed. ``--status`` prints one line per second on stderr.
 
 ``--emulate-boards`` (with ``--can-interface virtual``) runs
-`daemon.board_emulator.BoardEmulator` in the process on the same virtual channels: the
+`daemon.can.emulator.BoardEmulator` in the process on the same virtual channels: the
 whole CAN path without hardware.
 
 Exit codes: 0 stopped by a signal, 1 failed while running, 2 bad input.
@@ -92,18 +92,18 @@ def _single_instance(instance: str) -> socket.socket:
 
 def _backend(args):
     if args.backend == "sim":
-        from daemon.backend_sim import SimBackend
+        from daemon.sim.backend import SimBackend
         from ladders.loader import load_ladder
 
         return SimBackend(load_ladder(args.ladder), args.robot, homed=args.homed), None
-    from daemon.backend_can import CanBackend, parse_channels
+    from daemon.can.backend import CanBackend, parse_channels
 
     chans = parse_channels(args.channels)
     emu = None
     if args.emulate_boards:
         if args.can_interface != "virtual":
             raise InputError("--emulate-boards needs --can-interface virtual")
-        from daemon.board_emulator import BoardEmulator
+        from daemon.can.emulator import BoardEmulator
         from daemon.tables import load_joint_table, load_sensor_table
 
         emu = BoardEmulator(load_joint_table(), load_sensor_table(),

@@ -11,7 +11,7 @@ Every 5 ms tick, at an absolute deadline ``t0 + k·period`` (``CLOCK_MONOTONIC``
 4. the reference: the newest ``ref`` sample (its neck joints overridden by ``ref-neck``),
    or a hold, see below;
 5. the per-joint control law, `daemon.joint_control.JointController`, the same object
-   ``validate-plan`` runs in lock-step (`execute.simulate`);
+   ``validate-plan`` runs in lock-step (`execute.validate.simulate`);
 6. ``backend.write_commands(...)``: references, PWM duties and modes to the boards;
 7. the state: written to the ``state`` channel and appended to the state log;
 8. ``backend.idle(next_deadline)`` (the CAN backend spreads its sends here), then sleep
@@ -184,7 +184,7 @@ class BoardCommands:
 
 
 class Backend(Protocol):
-    """What the loop needs from the boards (`daemon.backend_sim`, `daemon.backend_can`).
+    """What the loop needs from the boards (`daemon.sim.backend`, `daemon.can.backend`).
 
     Attributes:
         name: ``"sim"`` or ``"can"``.

@@ -1,9 +1,14 @@
 """The ladder-climbing planner (thesis §6.3.1).
 
-Modules, one concept each: ``contacts`` (holds, stances), ``stability`` (support region,
-torque LP), ``kinematics`` (placo/pinocchio model), ``collision`` (coal), ``ik``,
-``validity`` (the feasibility predicate), ``feasible`` (Algorithm 6), ``interpolation``
-(contact-space recursive interpolation), ``limb_path``, ``search`` (Algorithm 5),
-``timing`` (toppra), ``output`` (trajectory and sidecar), ``cli`` (``plan-ladder``),
-``check_plan`` (``check-plan``). Importing the package itself loads nothing heavy.
+One concept per module or sub-package:
+- `contacts` (holds, stances) and `holds` (hold geometry on rungs, rails and floor);
+- `statics`: the support region and torque LP (`stability`), the arms' share (`arm_capacity`);
+- `configuration`: robot model, collision, IK, the feasibility predicate and the search for
+  a feasible configuration (Algorithm 6);
+- `paths`: contact-space recursive interpolation and the moving limb's path;
+- `search` (Algorithm 5), `timing` (toppra), `time_limit`;
+- `output` (trajectory and sidecar), `plots`, `cli` (``plan-ladder``);
+- `verify`: ``check-plan``, a verifier independent of the planner.
+
+Importing the package itself loads nothing heavy.
 """

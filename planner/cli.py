@@ -25,8 +25,8 @@ import sys
 import time
 from pathlib import Path
 
-from planner.arm_capacity import DEFAULT_POSITION_TORQUE_SHARE
 from planner.holds import FOOT_COP_MARGIN_M, FOOT_FRICTION_SHARE
+from planner.statics.arm_capacity import DEFAULT_POSITION_TORQUE_SHARE
 from robot.errors import HuboLadderError, InputError
 
 __all__ = ["main"]

@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pinocchio as pin
 
-from planner.arm_capacity import DEFAULT_ARM_STRATEGY, arms_comply_while_gripping
+from planner.statics.arm_capacity import DEFAULT_ARM_STRATEGY, arms_comply_while_gripping
 from robot.joints import ARM_JOINTS
 from robot.plan_sidecar import (
     ArmFeedforward,
@@ -114,12 +114,12 @@ def segment_paths(result: SearchResult, kin, q_start: np.ndarray | None = None,
             configuration if None.
         arm_strategy: how gripping arms are driven; under ``mixed`` a segment in which
             a hand holds its rail, closes on it or opens, moves that arm no faster than
-            its compliant joints can follow (`planner.arm_capacity`).
+            its compliant joints can follow (`planner.statics.arm_capacity`).
 
     Returns:
         One `SegmentPath` per segment; the last segment of each step dwells after it.
     """
-    from planner.arm_capacity import gripping_sides, gripping_velocity_limits
+    from planner.statics.arm_capacity import gripping_sides, gripping_velocity_limits
     from planner.timing import SegmentPath
     from robot.limits import joint_limits
 
@@ -221,7 +221,7 @@ def held_palm_turn_rad(palms: dict[str, np.ndarray], holding: dict[str, np.ndarr
     """How far each held palm has turned since its hand closed on the rail, per line [rad].
 
     The holds fix a palm's position and grip axis only, so a held hand may turn about its
-    rail from line to line, as a hooked hand does (`daemon.grasp_latch`: the turn costs
+    rail from line to line, as a hooked hand does (`daemon.sim.grasp_latch`: the turn costs
     the friction of the load across the rail); a grip that squeezed the rail would resist
     it with more than a compliant arm gives.
 
@@ -326,7 +326,7 @@ def _finite(x: float) -> float | None:
 
 def _metrics(result: SearchResult, planner: ClimbPlanner, timed: TimedPlan,
              segments: list[Segment], clearance_every: int) -> dict[str, Any]:
-    from planner.check_plan import allowed_contacts  # the verifier's rule, shared
+    from planner.verify.check import allowed_contacts  # the verifier's rule, shared
 
     stats = result.step_stats
     per_primitive: dict[str, dict[str, float]] = {}

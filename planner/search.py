@@ -17,21 +17,21 @@ import pinocchio as pin
 
 from ladders.geometry import LadderGeometry
 from ladders.spec import LadderSpec
-from planner.arm_capacity import DEFAULT_ARM_STRATEGY, DEFAULT_POSITION_TORQUE_SHARE
-from planner.collision import CollisionModel
+from planner.configuration.collision import CollisionModel
+from planner.configuration.feasible import FeasibleSearchStats, SearchTarget, find_feasible
+from planner.configuration.ik import IKConfig, solve_ik
+from planner.configuration.kinematics import HuboKinematics
+from planner.configuration.validity import FeasibilityChecker
 from planner.contacts import Hold, Stance
-from planner.feasible import FeasibleSearchStats, SearchTarget, find_feasible
 from planner.holds import FOOT_COP_MARGIN_M, FOOT_FRICTION_SHARE, GRIP_STYLES, make_hold
-from planner.ik import IKConfig, solve_ik
-from planner.interpolation import (
+from planner.paths.interpolation import (
     InterpolationError,
     InterpolationStats,
     contact_space_interpolate,
 )
-from planner.kinematics import HuboKinematics
-from planner.limb_path import foot_waypoints, hand_waypoints
-from planner.limb_rrt import plan_limb_path
-from planner.validity import FeasibilityChecker
+from planner.paths.limb_path import foot_waypoints, hand_waypoints
+from planner.paths.limb_rrt import plan_limb_path
+from planner.statics.arm_capacity import DEFAULT_ARM_STRATEGY, DEFAULT_POSITION_TORQUE_SHARE
 from primitives.hold_seeds import FloorSeed, RailSeed
 from primitives.library import climb_sequence
 from primitives.primitive import Step
@@ -93,7 +93,7 @@ class PlannerConfig:
     foot_cop_margin_m: float = FOOT_COP_MARGIN_M
     # Share of the ladder's μ a foot is planned to (planner.holds.FOOT_FRICTION_SHARE).
     foot_friction_share: float = FOOT_FRICTION_SHARE
-    # The OMPL fallback (planner.limb_rrt): RRTConnect's budget in collision checks
+    # The OMPL fallback (planner.paths.limb_rrt): RRTConnect's budget in collision checks
     # (≈ 0.1 ms each; an arm through a steep ladder's rungs took up to 26,000), tried on
     # at most this many samples of a step, as a failed search costs the whole budget, and
     # only in the last samples before the step gives up. A pose whose arc collides sits
@@ -393,7 +393,7 @@ class ClimbPlanner:
 
     def _limb_detour(self, qa, qb, limbs, support, stability, contacts, stats: StepStats,
                      exc: InterpolationError, attempt: int) -> list[np.ndarray]:
-        """The OMPL fallback (`planner.limb_rrt`) where the arc between two way-point
+        """The OMPL fallback (`planner.paths.limb_rrt`) where the arc between two way-point
         configurations collides, in a step's last samples (`PlannerConfig`): the body
         moves to ``qb``'s with the moving limbs' joints held (contact-space
         interpolation), then RRTConnect moves one limb at a time with everything else held

@@ -2,7 +2,7 @@
 
 Robot data shared by the daemon, which drives compliant joints with these gains
 (`daemon.pwm`), and the planner, which must know how much torque a compliant arm can give
-(`planner.arm_capacity`). Units are hubo-ach's: kp [%/rad], kd [%/(rad/s)], max_pwm [%].
+(`planner.statics.arm_capacity`). Units are hubo-ach's: kp [%/rad], kd [%/(rad/s)], max_pwm [%].
 
 Safety limits (thesis manual): ``kp < 70``, ``kd < 10``, ``max_pwm < 8``. The DRC-Hubo
 documented defaults break them (shoulder pitch/roll 80/0/8, shoulder yaw 70/0/7).

@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from execute.batch_jobs import PlanJob, ValidateJob
+from execute.batch.jobs import PlanJob, ValidateJob
 
 RAISE_PLAN_SEED = 99
 RAISE_VALIDATE_SEED = 13

@@ -13,9 +13,9 @@ from functools import cache
 import numpy as np
 
 from ladders.loader import load_ladder
+from planner.configuration.ik import solve_ik
 from planner.contacts import Stance
-from planner.ik import solve_ik
-from planner.interpolation import contact_space_interpolate
+from planner.paths.interpolation import contact_space_interpolate
 from planner.search import ClimbPlanner, PathSegment, SearchResult, StepStats
 from primitives.library import STRAIGHTEN
 from primitives.primitive import Step

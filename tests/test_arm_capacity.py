@@ -4,7 +4,9 @@ import numpy as np
 import pytest
 
 from ladders.loader import load_ladder
-from planner.arm_capacity import (
+from planner.configuration.kinematics import ARM_LIMIT_MARGIN_RAD, HuboKinematics
+from planner.search import ClimbPlanner, PlannerConfig, StepStats
+from planner.statics.arm_capacity import (
     BACK_EMF_SHARE,
     balance_stance,
     compliant_speed_rad_s,
@@ -12,9 +14,7 @@ from planner.arm_capacity import (
     gripping_torque_limits,
     gripping_velocity_limits,
 )
-from planner.kinematics import ARM_LIMIT_MARGIN_RAD, HuboKinematics
-from planner.search import ClimbPlanner, PlannerConfig, StepStats
-from planner.stability import support_region, torque_feasibility, torque_limits_by_joint
+from planner.statics.stability import support_region, torque_feasibility, torque_limits_by_joint
 from primitives.library import climb_sequence
 from robot.joints import ARM_JOINTS, JOINT_INDEX
 from robot.limits import joint_limits

@@ -11,9 +11,9 @@ import can
 import numpy as np
 import pytest
 
-from daemon import can_protocol as cp
-from daemon.backend_can import CanBackend, parse_channels
-from daemon.board_emulator import BoardEmulator
+from daemon.can import protocol as cp
+from daemon.can.backend import CanBackend, parse_channels
+from daemon.can.emulator import BoardEmulator
 from daemon.loop import BoardCommands, DaemonChannels, DaemonLoop, LoopConfig
 from daemon.structs import REF_DTYPE, BoardCommandType, StatusFlag, new_sample
 from daemon.tables import load_joint_table, load_sensor_table

@@ -20,10 +20,10 @@ sys.path.insert(0, str(Path(__file__).parent))
 
 import batch_small_jobs as small  # noqa: E402
 
-from execute.batch_cli import main, parse_args, run  # noqa: E402
-from execute.batch_jobs import JobFunctions  # noqa: E402
-from execute.batch_runner import RESULTS_FILE  # noqa: E402
-from execute.verdict import Failure  # noqa: E402
+from execute.batch.cli import main, parse_args, run  # noqa: E402
+from execute.batch.jobs import JobFunctions  # noqa: E402
+from execute.batch.runner import RESULTS_FILE  # noqa: E402
+from execute.validate.verdict import Failure  # noqa: E402
 
 SMALL = JobFunctions(plan=small.small_plan, validate=small.small_validate)
 

@@ -15,11 +15,11 @@ sys.path.insert(0, str(Path(__file__).parent))
 
 import batch_small_jobs as small  # noqa: E402
 
-from execute.batch_engine import dask_engine, local_engine  # noqa: E402
-from execute.batch_jobs import JobFunctions, expand_jobs  # noqa: E402
-from execute.batch_perturb import parse_perturb  # noqa: E402
-from execute.batch_results import comparable  # noqa: E402
-from execute.batch_runner import run_batch  # noqa: E402
+from execute.batch.engine import dask_engine, local_engine  # noqa: E402
+from execute.batch.jobs import JobFunctions, expand_jobs  # noqa: E402
+from execute.batch.perturb import parse_perturb  # noqa: E402
+from execute.batch.results import comparable  # noqa: E402
+from execute.batch.runner import run_batch  # noqa: E402
 from ladders.loader import load_ladder  # noqa: E402
 
 SMALL = JobFunctions(plan=small.small_plan, validate=small.small_validate)

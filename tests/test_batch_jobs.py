@@ -19,12 +19,12 @@ sys.path.insert(0, str(Path(__file__).parent))
 
 import batch_small_jobs as small  # noqa: E402
 
-from execute.batch_engine import local_engine  # noqa: E402
-from execute.batch_jobs import JobFunctions, expand_jobs  # noqa: E402
-from execute.batch_perturb import Draw, PerturbSpec, draw, parse_perturb  # noqa: E402
-from execute.batch_results import ResultsLog  # noqa: E402
-from execute.batch_runner import RESULTS_FILE, run_batch  # noqa: E402
-from execute.batch_sweep import parse_sweep_yaml  # noqa: E402
+from execute.batch.engine import local_engine  # noqa: E402
+from execute.batch.jobs import JobFunctions, expand_jobs  # noqa: E402
+from execute.batch.perturb import Draw, PerturbSpec, draw, parse_perturb  # noqa: E402
+from execute.batch.results import ResultsLog  # noqa: E402
+from execute.batch.runner import RESULTS_FILE, run_batch  # noqa: E402
+from execute.batch.sweep import parse_sweep_yaml  # noqa: E402
 from ladders.loader import load_ladder  # noqa: E402
 from robot.errors import InputError  # noqa: E402
 
@@ -140,7 +140,7 @@ def test_random_sweep_is_seeded():
 
 
 def test_the_benchmark_s_random_ladders_span_the_issue_s_ranges():
-    from execute.batch_sweep import load_sweep
+    from execute.batch.sweep import load_sweep
 
     cells = load_sweep(Path(__file__).parents[1] / "bench" / "random_ladders.yaml")
     assert len(cells) == 40
@@ -220,7 +220,7 @@ def test_interrupted_run_resumes_without_redoing_jobs(tmp_path, engine):
     assert second.skipped == len(done_before) and not second.errors
 
     # a clean run in another directory gives the same outcomes
-    from execute.batch_results import comparable
+    from execute.batch.results import comparable
 
     clean = run_batch(plans, vals, tmp_path / "clean", engine, functions=SMALL)
     strip = [{k: v for k, v in comparable(r).items() if k != "finished_at"}

@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from execute.batch_stats import SuccessRate, summarize, wilson_interval
+from execute.batch.stats import SuccessRate, summarize, wilson_interval
 
 # Hand-computed with z = 1.959964 (z² = 3.841459), denominator 1 + z²/n:
 #   0/10:  centre = 0.192073 / 1.384146 = 0.138766;

@@ -9,8 +9,8 @@ import can
 import numpy as np
 import pytest
 
-from daemon import can_protocol as cp
-from daemon.board_emulator import BoardEmulator
+from daemon.can import protocol as cp
+from daemon.can.emulator import BoardEmulator
 from daemon.tables import load_joint_table, load_sensor_table
 
 _ids = itertools.count()

@@ -11,10 +11,10 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).parent / "fixtures"))
 
-from daemon.board_model import BoardModel, BoardModelConfig  # noqa: E402
-from daemon.board_trip import BOARDS, BoardTripConfig, BoardTripMonitor  # noqa: E402
 from daemon.joint_control import ControlOutput, JointController  # noqa: E402
 from daemon.pwm import default_drc_gains  # noqa: E402
+from daemon.sim.board_model import BoardModel, BoardModelConfig  # noqa: E402
+from daemon.sim.board_trip import BOARDS, BoardTripConfig, BoardTripMonitor  # noqa: E402
 from ladders.loader import load_ladder  # noqa: E402
 from robot.errors import InputError  # noqa: E402
 from robot.joints import JOINT_INDEX, NUM_JOINTS  # noqa: E402

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from daemon import can_protocol as cp
+from daemon.can import protocol as cp
 from daemon.structs import StatusFlag
 from daemon.tables import load_joint_table, load_sensor_table
 

@@ -15,8 +15,9 @@ sys.path.insert(0, str(Path(__file__).parent))
 
 from synthetic_plan import synthetic_plan  # noqa: E402
 
-from planner.check_plan import CHECKS, allowed_contacts, main  # noqa: E402
 from planner.output import write_plan  # noqa: E402
+from planner.verify.check import CHECKS, allowed_contacts  # noqa: E402
+from planner.verify.cli import main  # noqa: E402
 from robot.joints import JOINT_INDEX  # noqa: E402
 from robot.limits import joint_limits  # noqa: E402
 from robot.plan_sidecar import HoldRecord, Segment, sidecar_path  # noqa: E402
@@ -125,10 +126,10 @@ def test_collision_is_reported(good, tmp_path, capsys):
 
 def test_a_lone_compliant_hand_is_not_counted_on_for_balance():
     """check-plan's support region of a one-hand stance is the feet's under mixed arms
-    (`planner.arm_capacity.balance_stance`), and reaches behind them with a rigid arm."""
+    (`planner.statics.arm_capacity.balance_stance`), and reaches behind them with a rigid arm."""
     from ladders.geometry import LadderGeometry
     from ladders.loader import load_ladder
-    from planner.check_plan import _Verifier
+    from planner.verify.check import _Verifier
 
     spec = load_ladder("drc")
     p0, p1 = LadderGeometry(spec).rail_axis("right")

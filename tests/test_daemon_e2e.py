@@ -117,7 +117,7 @@ class Daemon:
 
 
 def play(instance: str, *args: str, wait: bool = True):
-    cmd = [PY, "-m", "execute.play_cli", "--instance", instance, "-q", *args]
+    cmd = [PY, "-m", "execute.play.cli", "--instance", instance, "-q", *args]
     if not wait:
         return subprocess.Popen(cmd, env=ENV, cwd=ROOT, stderr=subprocess.PIPE, text=True)
     return subprocess.run(cmd, env=ENV, cwd=ROOT, capture_output=True, text=True, timeout=120)

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import json
 
-from execute.validate_cli import main as validate_main
+from execute.validate.cli import main as validate_main
 from ladders.loader import load_ladder
 from planner.cli import main as plan_main
 from robot.plan_sidecar import read_sidecar, sidecar_path

@@ -14,13 +14,13 @@ sys.path.insert(0, str(Path(__file__).parent / "fixtures"))
 
 from make_fixture import cached_reach_fixture  # noqa: E402
 
-from daemon.board_model import PlacementError  # noqa: E402
 from daemon.control_modes import RefMode  # noqa: E402
-from daemon.grasp_latch import GripCapacity, GripConfig  # noqa: E402
 from daemon.joint_control import JointController  # noqa: E402
 from daemon.pwm import default_drc_gains  # noqa: E402
-from execute.metrics import compute_metrics  # noqa: E402
-from execute.simulate import SimulationOptions, simulate  # noqa: E402
+from daemon.sim.board_model import PlacementError  # noqa: E402
+from daemon.sim.grasp_latch import GripCapacity, GripConfig  # noqa: E402
+from execute.validate.metrics import compute_metrics  # noqa: E402
+from execute.validate.simulate import SimulationOptions, simulate  # noqa: E402
 from ladders.spec import LadderSpec  # noqa: E402
 from robot.joints import ARM_JOINTS, FINGER_JOINTS, JOINT_INDEX, NUM_JOINTS  # noqa: E402
 from robot.kinematic_tree import FINGER_CLOSED_RAD  # noqa: E402

@@ -14,9 +14,9 @@ sys.path.insert(0, str(Path(__file__).parent))
 from synthetic_plan import synthetic_plan  # noqa: E402
 
 from ladders.loader import ladder_to_yaml, load_ladder  # noqa: E402
-from planner import check_plan  # noqa: E402
 from planner.cli import main  # noqa: E402
 from planner.search import ClimbPlanner  # noqa: E402
+from planner.verify import cli as check_plan_cli  # noqa: E402
 from robot.plan_sidecar import read_sidecar, sidecar_path  # noqa: E402
 
 
@@ -111,7 +111,7 @@ def test_happy_path_writes_checkable_files_and_plots(fake_search, tmp_path, caps
         assert image.std() > 10  # a scene, not a blank frame
     else:
         assert "no snapshot strip" in cap.err
-    assert check_plan.main([str(out), "--ladder", "drc", "--every", "25"]) == 0
+    assert check_plan_cli.main([str(out), "--ladder", "drc", "--every", "25"]) == 0
 
 
 def test_same_seed_same_file(fake_search, tmp_path):
@@ -130,7 +130,7 @@ def test_real_mount_plan_is_deterministic_and_checks(tmp_path):
         assert main(["drc", "--top-rung", "0", "--seed", "1", "--time-limit", "60",
                      "-o", str(path)]) == 0
     assert a.read_bytes() == b.read_bytes()
-    assert check_plan.main([str(a), "--ladder", "drc", "--every", "5"]) == 0
+    assert check_plan_cli.main([str(a), "--ladder", "drc", "--every", "5"]) == 0
 
 
 def test_plan_qpos_puts_the_scene_robot_where_the_planner_has_it():

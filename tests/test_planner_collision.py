@@ -9,7 +9,7 @@ import pinocchio as pin
 from ladders.collision import ladder_collision_objects
 from ladders.loader import load_ladder
 from ladders.scene import build_scene
-from planner.collision import CollisionModel
+from planner.configuration.collision import CollisionModel
 from robot.mjcf import ROBOT_CONTYPE, joint_qpos_addresses
 from robot.params import robot_params
 from robot.urdf import robot_urdf

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from ladders.loader import load_ladder
+from planner.configuration.ik import IKConfig, solve_ik
 from planner.contacts import Hold, Stance
-from planner.ik import IKConfig, solve_ik
-from planner.interpolation import InterpolationError, contact_space_interpolate
+from planner.paths.interpolation import InterpolationError, contact_space_interpolate
 from planner.search import ClimbPlanner, PlannerConfig, PlanningFailed, StepStats
 from primitives.library import climb_sequence
 
@@ -250,7 +250,7 @@ def test_narrow_rails_mount_leaves_the_arms_a_lift_off_within_their_torque():
     rails clear of the shoulders, collision-free, and once the left foot is on rung 0 the
     floor foot can lift with the compliant arms within their torque and the elbows off their
     fold limit (with the hands beside the shoulders it was rarely found)."""
-    from planner.feasible import find_feasible
+    from planner.configuration.feasible import find_feasible
 
     p = ClimbPlanner(load_ladder("ship"), seed=1)
     q, stance = p.start_configuration()
@@ -276,7 +276,7 @@ def test_wrist_pitch_stops_short_of_the_closed_fingers(robot):
     planner bounds each wrist pitch where they still clear it at every wrist roll."""
     import pinocchio as pin
 
-    from planner.kinematics import HuboKinematics
+    from planner.configuration.kinematics import HuboKinematics
     from planner.search import WRIST_FOLD_MARGIN_RAD, WRIST_FOLD_SCAN_STEP_RAD
     from robot.joints import FINGER_JOINTS
     from robot.kinematic_tree import FINGER_CLOSED_RAD
@@ -324,7 +324,7 @@ def _left_arm_pair(planner, q):
 
 
 def test_rrt_fallback_goes_around_what_the_straight_line_hits(planner, standing):
-    from planner.limb_rrt import plan_limb_path
+    from planner.paths.limb_rrt import plan_limb_path
     from robot.joints import LEFT_ARM
 
     q, stance = standing
@@ -354,7 +354,7 @@ import numpy as np
 sys.path.insert(0, {tests!r})
 from test_planner_search import _left_arm_pair
 from ladders.loader import load_ladder
-from planner.limb_rrt import plan_limb_path
+from planner.paths.limb_rrt import plan_limb_path
 from planner.search import ClimbPlanner
 from robot.joints import LEFT_ARM
 p = ClimbPlanner(load_ladder("drc"), seed=1)
@@ -381,7 +381,7 @@ def test_rrt_fallback_is_deterministic_per_process():
 
 
 def test_rrt_fallback_holds_the_body(planner, standing):
-    from planner.limb_rrt import plan_limb_path
+    from planner.paths.limb_rrt import plan_limb_path
     from robot.joints import LEFT_ARM
 
     q, stance = standing
@@ -412,7 +412,7 @@ def test_start_lowers_the_arms_where_the_rungs_are_within_reach_of_the_chest(pla
 def test_rrt_fallback_takes_ends_a_rounding_error_past_a_limit(planner, standing):
     # The planner's own check allows LIMIT_TOL past a limit; OMPL, given bounds that
     # exclude the goal, used to wait for a valid goal forever.
-    from planner.limb_rrt import plan_limb_path
+    from planner.paths.limb_rrt import plan_limb_path
     from robot.joints import LEFT_ARM
 
     q, stance = standing

@@ -8,7 +8,7 @@ import pytest
 from daemon.control_modes import TICK_S, RefMode
 from daemon.joint_control import JointController
 from daemon.pwm import default_drc_gains
-from execute.player import (
+from execute.play.player import (
     ArmModeSchedule,
     ModeScheduleError,
     PlayerOptionError,

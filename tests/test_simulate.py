@@ -13,11 +13,11 @@ sys.path.insert(0, str(Path(__file__).parent / "fixtures"))
 
 from make_fixture import cached_reach_fixture  # noqa: E402
 
-from daemon.board_model import BoardModel, PlacementError  # noqa: E402
 from daemon.joint_control import JointController  # noqa: E402
 from daemon.pwm import default_drc_gains  # noqa: E402
-from execute.plan_compare import compare_with_plan  # noqa: E402
-from execute.simulate import SimulationOptions, simulate  # noqa: E402
+from daemon.sim.board_model import BoardModel, PlacementError  # noqa: E402
+from execute.validate.plan_compare import compare_with_plan  # noqa: E402
+from execute.validate.simulate import SimulationOptions, simulate  # noqa: E402
 from ladders.loader import BUNDLED_LADDERS, load_ladder  # noqa: E402
 from ladders.spec import LadderSpec  # noqa: E402
 from robot.errors import InputError  # noqa: E402

@@ -1,4 +1,4 @@
-"""Static stability: friction cones, CoM support region, torque LP (planner/stability.py)."""
+"""Static stability: friction cones, CoM support region, torque LP (planner.statics.stability)."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ import pytest
 from scipy.spatial import ConvexHull
 
 from planner.contacts import Hold, Stance
-from planner.stability import (
+from planner.statics.stability import (
     StabilityConfig,
     StabilityError,
     SupportRegion,

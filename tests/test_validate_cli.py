@@ -15,7 +15,7 @@ sys.path.insert(0, str(Path(__file__).parent / "fixtures"))
 
 from make_fixture import cached_reach_fixture  # noqa: E402
 
-from execute.validate_cli import main  # noqa: E402
+from execute.validate.cli import main  # noqa: E402
 from robot.plan_sidecar import sidecar_path  # noqa: E402
 
 
@@ -91,7 +91,7 @@ def test_plots_written_or_rendering_reported(plan, tmp_path):
     # a fresh interpreter, so MUJOCO_GL=egl is set before mujoco is imported
     env = {**os.environ, "MUJOCO_GL": "egl"}
     out = tmp_path / "p"
-    proc = subprocess.run([sys.executable, "-m", "execute.validate_cli", str(plan),
+    proc = subprocess.run([sys.executable, "-m", "execute.validate.cli", str(plan),
                            "--strategy", "position", "--plots", str(out)],
                           capture_output=True, text=True, env=env, timeout=120)
     assert proc.returncode == 0, proc.stderr
@@ -105,7 +105,7 @@ def test_plots_written_or_rendering_reported(plan, tmp_path):
 
 def test_a_failure_is_compared_with_the_plan_at_its_line(results, plan):
     from ladders.loader import load_ladder
-    from planner.check_plan import planned_loads
+    from planner.verify.check import planned_loads
     from robot.plan_sidecar import read_sidecar
     from robot.trajectory_file import read_trajectory
 

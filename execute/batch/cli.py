@@ -1,0 +1,295 @@
+"""``batch-eval``: success rates over ladders × seeds × strategies × perturbations.
+
+    batch-eval [--ladders drc,ship,stair | --sweep SWEEP.yaml] [--seeds N] [--first-seed S]
+               [--strategies mixed,position,pwm] [--perturb KEY=V,...] [--draws D]
+               [--engine local|dask] [--address tcp://host:8786] [--workers K]
+               [--out DIR] [--time-limit S] [--top-rung K] [--robot R] [--rate HZ]
+               [--max-jobs N] [--no-plots] [-v]
+
+Per (ladder, seed) one plan (seeds S..S+N−1), then per strategy × perturbation draw one
+simulated climb of that plan (`execute.batch.jobs`; perturbations:
+`execute.batch.perturb`; sweeps: `execute.batch.sweep`). Jobs run on a local process
+pool or a Dask cluster (`execute.batch.engine`). Every finished job is appended to
+``DIR/results.jsonl``; running the same command again skips finished jobs and retries
+errored ones. At the end: the success table (printed, ``DIR/summary.csv``,
+``DIR/summary.md``) and plots in ``DIR/plots``.
+
+Exit codes: 0 every job has an outcome (climbs may have failed: that is the data); 1 some
+jobs errored or the cluster failed; 2 bad input (the message names the flag or the file
+and line); 130 interrupted (rerun to resume).
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import math
+import os
+import sys
+import time
+from pathlib import Path
+
+from robot.errors import HuboLadderError, InputError
+
+__all__ = ["main", "parse_args"]
+
+log = logging.getLogger("batch-eval")
+
+STRATEGIES = ("mixed", "position", "pwm")
+MAX_SEEDS = 10_000
+MAX_WORKERS = 256
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="batch-eval", description=__doc__.split("\n\n")[0])
+    src = p.add_mutually_exclusive_group()
+    src.add_argument("--ladders", default=None,
+                     help="comma-separated bundled ladders or spec files (default drc)")
+    src.add_argument("--sweep", metavar="SWEEP.yaml", help="a sweep file of ladder parameters")
+    p.add_argument("--seeds", type=int, default=1, metavar="N",
+                   help=f"plans per ladder, seeds S..S+N-1 (1..{MAX_SEEDS}, default 1)")
+    p.add_argument("--first-seed", type=int, default=1, metavar="S", help="first seed (default 1)")
+    p.add_argument("--strategies", default=",".join(STRATEGIES),
+                   help="comma-separated arm strategies (default mixed,position,pwm)")
+    p.add_argument("--perturb", default="", metavar="KEY=V,...",
+                   help="placement=M,yaw=RAD,rung=M,friction=LO:HI,battery=LO:HI")
+    p.add_argument("--draws", type=int, default=1, metavar="D",
+                   help="perturbation draws per plan and strategy (default 1)")
+    p.add_argument("--engine", default="local", help="local (process pool) or dask")
+    p.add_argument("--address", metavar="tcp://HOST:PORT",
+                   help="Dask scheduler (--engine dask; default: start a LocalCluster)")
+    p.add_argument("--workers", type=int, default=None, metavar="K",
+                   help="worker processes (default: the CPU count)")
+    p.add_argument("--out", default="batch-out", metavar="DIR", help="output directory")
+    p.add_argument("--time-limit", type=float, default=600.0, metavar="S",
+                   help="planning time limit per plan [s] (default 600)")
+    p.add_argument("--top-rung", type=int, default=None, metavar="K",
+                   help="climb until both feet are on rung K (default: the highest)")
+    p.add_argument("--robot", default="drc-hubo", help="drc-hubo or hubo2plus")
+    p.add_argument("--rate", type=float, default=200.0, metavar="HZ",
+                   help="trajectory rate [Hz] (default 200)")
+    p.add_argument("--max-jobs", type=int, default=None, metavar="N",
+                   help="run at most N jobs now, then stop (resume later)")
+    p.add_argument("--no-plots", action="store_true", help="skip the plots")
+    p.add_argument("-v", "--verbose", action="store_true", help="log job errors as they happen")
+    return p
+
+
+def _split(flag: str, text: str) -> list[str]:
+    items = [t.strip() for t in text.split(",") if t.strip()]
+    if not items:
+        raise InputError(f"option {flag} is empty")
+    dup = sorted({t for t in items if items.count(t) > 1})
+    if dup:
+        raise InputError(f"option {flag}: {', '.join(dup)} given twice")
+    return items
+
+
+def parse_args(argv: list[str] | None = None) -> dict:
+    """Parse and validate every option up front.
+
+    Returns:
+        A dict with ``ladders`` ([(key, spec, sweep values)]), ``seeds``, ``strategies``,
+        ``perturb`` (`PerturbSpec`), ``draws``, ``engine``, ``address``, ``workers``,
+        ``out``, ``time_limit_s``, ``top_rung``, ``robot``, ``rate_hz``, ``max_jobs``,
+        ``plots``, ``verbose``.
+
+    Raises:
+        InputError: naming the option or ``FILE:LINE`` and the allowed values.
+        SystemExit: argparse's own errors (exit 2) and ``--help`` (exit 0).
+    """
+    from execute.batch.perturb import parse_perturb
+    from ladders.loader import load_ladder
+
+    a = _parser().parse_args(argv)
+    for name, value, ok, rule in (
+            ("--seeds", a.seeds, 1 <= a.seeds <= MAX_SEEDS, f"in [1, {MAX_SEEDS}]"),
+            ("--first-seed", a.first_seed, 0 <= a.first_seed < 2**31, "in [0, 2^31)"),
+            ("--draws", a.draws, 1 <= a.draws <= 1000, "in [1, 1000]"),
+            ("--time-limit", a.time_limit, math.isfinite(a.time_limit) and a.time_limit > 0,
+             "> 0 s"),
+            ("--rate", a.rate, math.isfinite(a.rate) and 1 <= a.rate <= 1000,
+             "in [1, 1000] Hz"),
+            ("--workers", a.workers, a.workers is None or 1 <= a.workers <= MAX_WORKERS,
+             f"in [1, {MAX_WORKERS}]"),
+            ("--max-jobs", a.max_jobs, a.max_jobs is None or a.max_jobs >= 1, "≥ 1"),
+            ("--top-rung", a.top_rung, a.top_rung is None or a.top_rung >= 0, "≥ 0")):
+        if not ok:
+            raise InputError(f"option {name} is {value:g}; it must be {rule}")
+    if a.engine not in ("local", "dask"):
+        raise InputError(f"option --engine is {a.engine!r}; choose local or dask")
+    if a.address is not None:
+        if a.engine != "dask":
+            raise InputError("option --address needs --engine dask")
+        if "://" not in a.address:
+            raise InputError(f"option --address is {a.address!r}; expected a scheduler "
+                             "address like tcp://host:8786")
+    if a.robot not in ("drc-hubo", "hubo2plus"):
+        raise InputError(f"option --robot is {a.robot!r}; choose drc-hubo or hubo2plus")
+    strategies = _split("--strategies", a.strategies)
+    bad = [s for s in strategies if s not in STRATEGIES]
+    if bad:
+        raise InputError(f"option --strategies: {', '.join(bad)} unknown; choose from "
+                         f"{', '.join(STRATEGIES)}")
+    perturb = parse_perturb(a.perturb)
+    if a.draws > 1 and not perturb:
+        raise InputError(f"option --draws is {a.draws}, but there is no --perturb: every draw "
+                         "would be the same simulation")
+    if a.sweep:
+        from execute.batch.sweep import load_sweep
+
+        ladders = [(c.name, c.spec, c.params) for c in load_sweep(a.sweep)]
+    else:
+        ladders = []
+        for name in _split("--ladders", a.ladders or "drc"):
+            try:
+                spec = load_ladder(name)
+            except InputError as exc:
+                raise InputError(f"option --ladders: {exc}") from None
+            key = name if spec.name == name else spec.name
+            if any(k == key for k, _, _ in ladders):
+                raise InputError(f"option --ladders: two ladders are named '{key}'")
+            ladders.append((key, spec, {}))
+    for key, spec, _ in ladders:
+        perturb.check_ladder(spec)
+        if a.top_rung is not None and a.top_rung >= spec.num_rungs:
+            raise InputError(f"option --top-rung is {a.top_rung}; ladder '{key}' has rungs "
+                             f"0..{spec.num_rungs - 1}")
+    workers = a.workers or os.cpu_count() or 1
+    return {"ladders": ladders, "seeds": list(range(a.first_seed, a.first_seed + a.seeds)),
+            "strategies": strategies, "perturb": perturb, "draws": a.draws,
+            "engine": a.engine, "address": a.address, "workers": workers, "out": Path(a.out),
+            "time_limit_s": a.time_limit, "top_rung": a.top_rung, "robot": a.robot,
+            "rate_hz": a.rate, "max_jobs": a.max_jobs, "plots": not a.no_plots,
+            "verbose": a.verbose}
+
+
+def run(opts: dict, console, err, functions=None, engine=None) -> int:
+    """Run a parsed batch (see `parse_args`) and write its reports; returns the exit code.
+
+    Args:
+        opts: parsed options.
+        console: rich console for the tables (stdout).
+        err: rich console for progress and messages (stderr).
+        functions: job functions (`execute.batch.jobs.JobFunctions`; default the real ones).
+        engine: an engine to use instead of opening ``opts['engine']`` (tests).
+    """
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        TextColumn,
+        TimeElapsedColumn,
+        TimeRemainingColumn,
+    )
+
+    from execute.batch.engine import open_engine
+    from execute.batch.jobs import DEFAULT_JOB_FUNCTIONS, expand_jobs
+    from execute.batch.report import (
+        print_summary,
+        summarize_records,
+        write_csv,
+        write_markdown,
+    )
+    from execute.batch.runner import RESULTS_FILE, run_batch
+
+    plans, validations = expand_jobs(opts["ladders"], opts["seeds"], opts["strategies"],
+                                     opts["perturb"], opts["draws"], robot=opts["robot"],
+                                     time_limit_s=opts["time_limit_s"],
+                                     top_rung=opts["top_rung"], rate_hz=opts["rate_hz"])
+    out: Path = opts["out"]
+    out.mkdir(parents=True, exist_ok=True)
+    t0 = time.perf_counter()
+    eng = engine if engine is not None else open_engine(opts["engine"], opts["workers"],
+                                                        opts["address"])
+    err.print(f"batch-eval: {len(plans)} plan and {len(validations)} validate jobs on "
+              f"{eng.description}; results in {out / RESULTS_FILE}", highlight=False)
+    with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
+                  TimeElapsedColumn(), TextColumn("ETA"), TimeRemainingColumn(),
+                  console=err, transient=False) as progress:
+        task = progress.add_task("jobs", total=None)
+
+        def on_start(total: int, skipped: int) -> None:
+            if skipped:
+                err.print(f"resuming: {skipped} job(s) already finished, {total} to run",
+                          highlight=False)
+            progress.update(task, total=total)
+
+        def on_record(rec: dict) -> None:
+            status = rec.get("outcome") if rec["status"] == "ok" else "error"
+            progress.update(task, advance=1, description=f"jobs (last: {rec['key']} {status})")
+
+        try:
+            batch = run_batch(plans, validations, out, eng,
+                              functions=functions or DEFAULT_JOB_FUNCTIONS,
+                              on_start=on_start, on_record=on_record,
+                              max_jobs=opts["max_jobs"])
+        except BaseException:
+            if engine is None:  # interrupted: drop queued jobs, do not wait for them
+                eng.close(cancel=True)
+            raise
+        if engine is None:
+            eng.close()
+    expected: dict[tuple[str, str], int] = {}
+    for v in validations:
+        k = (v.plan.ladder_key, v.strategy)
+        expected[k] = expected.get(k, 0) + 1
+    expected_plans: dict[str, int] = {}
+    for p in plans:
+        expected_plans[p.ladder_key] = expected_plans.get(p.ladder_key, 0) + 1
+    summary = summarize_records(batch.records, {k: s for k, s, _ in opts["ladders"]},
+                                opts["strategies"], expected, expected_plans)
+    print_summary(summary, console)
+    files = [write_csv(summary, out / "summary.csv"), write_markdown(summary, out / "summary.md")]
+    if opts["plots"]:
+        from execute.batch.plots import write_plots
+
+        files += write_plots(summary, out / "plots")
+    wall = time.perf_counter() - t0
+    err.print(f"ran {batch.ran} job(s), skipped {batch.skipped} finished, in {wall:.1f} s; "
+              f"wrote {', '.join(str(f) for f in files)}", highlight=False, soft_wrap=True)
+    missing = len(plans) + len(validations) - len(batch.records)
+    if missing:
+        err.print(f"{missing} job(s) not run yet; run the same command again to continue",
+                  highlight=False)
+    if batch.errors:
+        err.print(f"{len(batch.errors)} job(s) errored (recorded in {out / RESULTS_FILE}); "
+                  f"first: {batch.errors[0]['key']}: {batch.errors[0].get('error')}",
+                  markup=False, highlight=False, soft_wrap=True)
+        return 1
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of ``batch-eval``; returns the exit code."""
+    from rich.console import Console
+
+    err = Console(stderr=True)
+    try:
+        opts = parse_args(argv)
+    except SystemExit as exc:  # argparse: --help (0) or a bad option (2)
+        return int(exc.code or 0)
+    except InputError as exc:
+        err.print(f"batch-eval: {exc}", markup=False, highlight=False, soft_wrap=True)
+        return 2
+    logging.basicConfig(level=logging.INFO if opts["verbose"] else logging.WARNING,
+                        format="%(name)s: %(message)s", force=True)
+    console = Console()
+    if not console.is_terminal:  # a log file or a pipe: keep each row on one line
+        console = Console(width=220)
+    try:
+        return run(opts, console, err)
+    except KeyboardInterrupt:
+        err.print(f"batch-eval: interrupted; finished jobs are in {opts['out']}/results.jsonl, "
+                  "run the same command again to resume", highlight=False)
+        return 130
+    except InputError as exc:
+        err.print(f"batch-eval: {exc}", markup=False, highlight=False, soft_wrap=True)
+        return 2
+    except (HuboLadderError, ImportError, OSError) as exc:
+        err.print(f"batch-eval: {exc}", markup=False, highlight=False, soft_wrap=True)
+        return 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,298 @@
+"""``play-trajectory``: hubo-read-trajectory's flags, playing a 40-column file to the daemon.
+
+    play-trajectory -n FILE [-f 10|25|50|100|200|500] [-i] [-c|-cl|-cr] [-nf] [-p]
+                    [-line N] [--no-auto-modes] [--instance NAME] [--robot R]
+
+Before anything is sent, the whole file is checked (`robot.trajectory_file`): a bad file
+exits 2 naming ``FILE:LINE:COLUMN``, and the ``ref`` channel is never written. The
+sidecar ``FILE.plan.json``, when present, gives the rate (unless ``-f``), the per-arm
+position/PWM schedule and the compliant arms' feed-forward (unless ``--no-auto-modes``);
+``-c``, ``-cl``, ``-cr`` force an arm compliant for the whole file. The feed-forward
+torques go out as each ``ref`` sample's ``pwm_command`` duty, at the battery voltage the
+daemon reports (as ``validate-plan`` plays them).
+
+Then it waits for a running ``hubo-daemon`` on ``--instance`` (its ``state`` channel
+ticking), refuses joints that are not homed, waits for a homing in progress to end, and
+without ``-i`` refuses to start when the robot stands farther than ``--line-tolerance``
+from the start line (``-line N``, 1-based). With ``-i`` it first moves there smoothly
+(minimum jerk, ``--init-s``, 3 s).
+
+It streams one ``ref`` sample per 5 ms (absolute deadlines), ``playing`` set, and shows
+the line, the time and the arms' modes. With ``-p``: the ``p`` key (when stdin is a
+terminal) and SIGUSR1 toggle pause; resuming continues where it stopped (no catch-up).
+At the end, and on Ctrl-C / SIGTERM, the last reference stays on the channel with
+``playing`` cleared: the robot holds it.
+
+Exit codes: 0 played to the end, 1 refused or failed (no daemon, not homed, too far from
+the start line), 2 bad input, 130 stopped by Ctrl-C (holding).
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import os
+import select
+import signal
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from robot.errors import HuboLadderError, InputError, run_cli
+
+__all__ = ["main"]
+
+log = logging.getLogger("play-trajectory")
+
+TICK_NS = 5_000_000
+DAEMON_WAIT_S = 3.0  # how long to wait for the daemon's state channel [s]
+HOMING_WAIT_S = 4.0  # how long to wait for a homing in progress to end [s]
+
+
+def _parser() -> argparse.ArgumentParser:
+    from execute.play.player import ALLOWED_RATES_HZ
+
+    p = argparse.ArgumentParser(prog="play-trajectory", allow_abbrev=False,
+                                description=__doc__.split("\n\n")[0])
+    p.add_argument("-n", dest="file", required=True, metavar="FILE",
+                   help="the 40-column trajectory file")
+    p.add_argument("-f", dest="rate", type=int, choices=ALLOWED_RATES_HZ, metavar="HZ",
+                   help="line rate: 10, 25, 50, 100, 200 or 500 Hz (default: the "
+                        "sidecar's, else 25)")
+    p.add_argument("-i", dest="init", action="store_true",
+                   help="go to the start line smoothly first")
+    arms = p.add_mutually_exclusive_group()
+    arms.add_argument("-c", dest="c", action="store_true", help="both arms compliant")
+    arms.add_argument("-cl", dest="cl", action="store_true", help="left arm compliant")
+    arms.add_argument("-cr", dest="cr", action="store_true", help="right arm compliant")
+    p.add_argument("-nf", dest="no_filter", action="store_true",
+                   help="direct reference mode: no daemon-side filter")
+    p.add_argument("-p", dest="pause", action="store_true",
+                   help="pause feature: key p (terminal) or SIGUSR1 toggles pause")
+    p.add_argument("-line", dest="line", type=int, default=1, metavar="N",
+                   help="start at 1-based line N")
+    p.add_argument("--no-auto-modes", action="store_true",
+                   help="ignore the sidecar's per-arm position/PWM schedule and "
+                        "feed-forward")
+    p.add_argument("--instance", default="default", help="daemon instance (default)")
+    p.add_argument("--robot", default=None, help="robot (default: the sidecar's or drc-hubo)")
+    p.add_argument("--init-s", type=float, default=3.0, metavar="S",
+                   help="duration of the -i move [s] (default 3)")
+    p.add_argument("--line-tolerance", type=float, default=0.05, metavar="RAD",
+                   help="without -i: largest joint distance to the start line [rad]")
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress line")
+    return p
+
+
+def _load(args):
+    """Everything that can be refused before a channel is touched."""
+    from execute.play.player import (
+        PlayerOptions,
+        TrajectoryPlayer,
+        compliant_arms_from_flags,
+    )
+    from robot.plan_sidecar import read_sidecar, sidecar_path
+    from robot.trajectory_file import read_trajectory
+
+    path = Path(args.file)
+    side = sidecar_path(path)
+    sidecar = read_sidecar(side) if side.exists() else None
+    rate = args.rate or (int(round(sidecar.rate_hz)) if sidecar else 25)
+    if sidecar and args.rate and args.rate != round(sidecar.rate_hz):
+        log.warning("%s was timed for %g Hz; playing it at %d Hz changes its speed", path,
+                    sidecar.rate_hz, args.rate)
+    robot = args.robot or (sidecar.robot if sidecar else "drc-hubo")
+    traj = read_trajectory(path, rate, robot)
+    if sidecar and len(traj) != sidecar.line_count:
+        raise InputError(f"{path}:{len(traj)}: the file has {len(traj)} lines, its sidecar "
+                         f"{side} says {sidecar.line_count}")
+    auto = sidecar is not None and not args.no_auto_modes
+    schedule = sidecar.arm_modes if auto else None
+    opts = PlayerOptions(rate_hz=rate, go_to_init=args.init, go_to_init_s=args.init_s,
+                         compliant_arms=compliant_arms_from_flags(args.c, args.cl, args.cr),
+                         no_filter=args.no_filter, start_line=args.line)
+    if not (np.isfinite(args.line_tolerance) and args.line_tolerance > 0):
+        raise InputError(f"--line-tolerance {args.line_tolerance}: must be > 0 [rad]")
+    player = TrajectoryPlayer(traj, opts, schedule, sidecar.arm_feedforward if auto else None)
+    return traj, player, auto
+
+
+def _wait_for_daemon(state, instance: str) -> np.ndarray:
+    from daemon.structs import StatusFlag
+    from robot.joints import JOINT_NAMES
+
+    deadline = time.monotonic() + DAEMON_WAIT_S
+    s = None
+    while time.monotonic() < deadline:
+        s = state.wait_newer(0 if s is None else int(s["time_ns"]), 0.2)
+        if s is not None and time.monotonic_ns() - int(s["time_ns"]) < 200_000_000:
+            break
+    else:
+        raise HuboLadderError(f"no hubo-daemon is running on instance {instance!r} (its "
+                              "state channel is silent); start it first")
+    unhomed = [JOINT_NAMES[j] for j in np.flatnonzero(np.asarray(s["zeroed"]) == 0)]
+    if unhomed:
+        raise HuboLadderError(f"joints not homed: {' '.join(unhomed)}; run "
+                              "`hubo-console` homeAll first")
+    deadline = time.monotonic() + HOMING_WAIT_S
+    while np.any(np.asarray(s["status"]) & int(StatusFlag.NOT_HOMED)):
+        if time.monotonic() > deadline:
+            raise HuboLadderError("the daemon still ignores references (homing or control "
+                                  "off); try again when `hubo-console statusAll` is clear")
+        time.sleep(0.05)
+        s = state.read_latest()
+    return s
+
+
+def _check_start(traj, line: int, pos: np.ndarray, tol: float) -> None:
+    from robot.joints import JOINT_NAMES
+
+    dev = np.abs(pos - traj[line - 1])
+    j = int(np.argmax(dev))
+    if dev[j] > tol:
+        raise HuboLadderError(
+            f"the robot is {dev[j]:.3f} rad from line {line} at {JOINT_NAMES[j]} (tolerance "
+            f"{tol:g} rad); move it there first or add -i to go there smoothly")
+
+
+class _Keys:
+    """``p`` key presses on a terminal stdin in cbreak mode (restored on close)."""
+
+    def __init__(self) -> None:
+        import termios
+        import tty
+
+        self.fd = sys.stdin.fileno()
+        self._saved = termios.tcgetattr(self.fd)
+        tty.setcbreak(self.fd)
+
+    def presses(self) -> int:
+        n = 0
+        while select.select([self.fd], [], [], 0)[0]:
+            data = os.read(self.fd, 64)
+            if not data:
+                break
+            n += data.lower().count(b"p")
+        return n
+
+    def close(self) -> None:
+        import termios
+
+        termios.tcsetattr(self.fd, termios.TCSADRAIN, self._saved)
+
+
+def _play(args, traj, player, auto) -> int:
+    from daemon.channels import open_channel
+    from daemon.loop import sleep_until_ns
+    from daemon.structs import REF_DTYPE, new_sample
+    from robot.motors import DEFAULT_BATTERY_V, motor_table
+
+    ref = open_channel("ref", args.instance)
+    state = open_channel("state", args.instance)
+    keys = None
+    flags = {"stop": False, "toggles": 0}
+    try:
+        s = _wait_for_daemon(state, args.instance)
+        if not args.init:
+            _check_start(traj, args.line, np.asarray(s["pos"]), args.line_tolerance)
+
+        def on_stop(signum, frame):
+            flags["stop"] = True
+
+        def on_usr1(signum, frame):
+            flags["toggles"] += 1
+
+        signal.signal(signal.SIGINT, on_stop)
+        signal.signal(signal.SIGTERM, on_stop)
+        if args.pause:
+            signal.signal(signal.SIGUSR1, on_usr1)
+            if sys.stdin.isatty():
+                keys = _Keys()
+        sample = new_sample(REF_DTYPE)
+        sample["playing"] = 1
+        motors = motor_table()
+        n = player.num_lines
+        if not args.quiet:
+            modes = "sidecar arm modes" if auto else "no sidecar arm modes"
+            print(f"play-trajectory: {args.file}: {n} lines at {player.options.rate_hz} Hz, "
+                  f"{player.duration_s:.1f} s, {modes}" + ("; p pauses" if args.pause else ""),
+                  file=sys.stderr, flush=True)
+        deadline = time.monotonic_ns()
+        next_show = 0.0
+        t0_s = time.monotonic()
+        tick = None
+        while True:
+            now_s = time.monotonic()
+            if keys is not None:
+                flags["toggles"] += keys.presses()
+            if flags["stop"]:
+                break
+            # The state only matters for go-to-init's start pose and the feed-forward's
+            # battery voltage.
+            latest = state.read_latest() if not player.started or player.has_feedforward \
+                else None
+            pos = np.asarray(latest["pos"]) if not player.started else None
+            if player.started:
+                while flags["toggles"]:
+                    flags["toggles"] -= 1
+                    player.toggle_pause(now_s)
+            tick = player.step(now_s, pos)
+            sample["ref"] = tick.ref_rad
+            sample["mode"] = tick.mode
+            sample["comply"] = tick.comply
+            if player.has_feedforward:
+                volts = float(latest["power"]["V"])
+                sample["pwm_command"] = player.feedforward_duty(
+                    tick, volts if volts > 0 else DEFAULT_BATTERY_V, motors)
+            if tick.finished:
+                sample["playing"] = 0
+            ref.write(sample)
+            if not args.quiet and (now_s >= next_show or tick.finished):
+                next_show = now_s + 0.25
+                phase = "done" if tick.finished else "paused" if tick.paused else \
+                    "init" if tick.going_to_init else "play"
+                t = now_s - t0_s
+                print(f"\rline {tick.line_number:5d}/{n}  t {t:6.2f} s  "
+                      f"left {tick.arm_modes['left']:8s}  right {tick.arm_modes['right']:8s}"
+                      f"  {phase:6s}", end="", file=sys.stderr, flush=True)
+            if tick.finished:
+                if not args.quiet:
+                    print(file=sys.stderr)
+                return 0
+            deadline += TICK_NS
+            now = time.monotonic_ns()
+            if now >= deadline:
+                deadline += ((now - deadline) // TICK_NS + 1) * TICK_NS
+            sleep_until_ns(deadline)
+        sample["playing"] = 0  # stop and hold: the last reference stays
+        ref.write(sample)
+        where = f"line {tick.line_number}" if tick is not None else "the start"
+        print(f"\nplay-trajectory: stopped at {where}; the robot holds the last reference",
+              file=sys.stderr, flush=True)
+        return 130
+    finally:
+        if keys is not None:
+            keys.close()
+        ref.close()
+        state.close()
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of ``play-trajectory``; returns the exit code."""
+    args = _parser().parse_args(argv)
+    logging.basicConfig(level=logging.WARNING, format="%(name)s: %(message)s")
+    def job() -> int:
+        traj, player, auto = _load(args)
+        return _play(args, traj, player, auto)
+
+    try:
+        return run_cli("play-trajectory", job)
+    except KeyboardInterrupt:  # before playback started: nothing was sent
+        print("play-trajectory: interrupted before playing", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

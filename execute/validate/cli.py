@@ -1,0 +1,187 @@
+"""``validate-plan``: play a plan in MuJoCo through the robot's own control code.
+
+    validate-plan PLAN.traj [--ladder L] [--strategy mixed|position|pwm] [--battery V]
+                  [--placement-error dx,dy,dyaw] [--json R.json] [--video V.mp4]
+                  [--plots DIR] [--robot R]
+
+Reads ``PLAN.traj`` and its sidecar ``PLAN.plan.json`` (rate, holds, arm schedule,
+ladder), runs `execute.validate.simulate.simulate`, prints the verdict and the metrics, and
+writes the result JSON and artifacts asked for.
+
+Exit codes: 0 the robot climbed, 1 it did not, 2 bad input (the message names the file
+and line or the option).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import os
+import sys
+from pathlib import Path
+
+from robot.errors import InputError, run_cli
+
+__all__ = ["ladder_from_sidecar", "main", "result_json"]
+
+log = logging.getLogger("validate-plan")
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="validate-plan", description=__doc__.split("\n\n")[0])
+    p.add_argument("plan", help="the 40-column trajectory (PLAN.traj); its sidecar "
+                               "PLAN.plan.json must sit next to it")
+    p.add_argument("--ladder", help="ladder name or spec file (default: the sidecar's)")
+    p.add_argument("--strategy", default="mixed", choices=("mixed", "position", "pwm"),
+                   help="arm modes: the sidecar's schedule, rigid, or compliant")
+    p.add_argument("--battery", type=float, default=48.0, metavar="V",
+                   help="battery voltage [V] (default 48)")
+    p.add_argument("--placement-error", default="0,0,0", metavar="dx,dy,dyaw",
+                   help="ladder misplacement [m, m, rad]")
+    p.add_argument("--json", metavar="R.json", help="write the result here")
+    p.add_argument("--video", metavar="V.mp4", help="write an MP4 (needs EGL)")
+    p.add_argument("--plots", metavar="DIR", help="write tracking plots and a snapshot strip")
+    p.add_argument("--robot", default=None, help="robot (default: the sidecar's)")
+    p.add_argument("-v", "--verbose", action="store_true", help="log events as they happen")
+    return p
+
+
+def ladder_from_sidecar(d: dict, where: str):
+    from ladders.loader import parse_ladder_yaml
+    from ladders.spec import LadderSpec
+
+    if "geometry" in d:  # the YAML layout
+        import yaml
+
+        return parse_ladder_yaml(yaml.safe_dump(d), where)
+    try:
+        return LadderSpec(**d)
+    except TypeError as exc:
+        raise InputError(f"{where}: field 'ladder' is not a ladder spec: {exc}") from None
+
+
+def _why(run, metrics, comparison=None) -> str:
+    """A sentence from the physical quantities behind the outcome (and, for a failure,
+    where the simulation had departed from the plan)."""
+    v = run.verdict
+    te = metrics.tracking_error_rad
+    track = (f"tracking error left {te['left']:.4f} rad, right {te['right']:.4f} rad; peak "
+             f"torque {metrics.peak_torque_ratio:.0%} of the limit at "
+             f"{metrics.peak_torque_joint}")
+    grips = "; ".join(str(g) for g in run.log.grasps) or "no grip events"
+    if v.climbed:
+        return f"every final hold in contact ({grips}); {track}"
+    departed = "" if comparison is None else f"; {comparison.summary()}"
+    return f"{v.failure.why} [{grips}]; {track}{departed}"
+
+
+def result_json(run, metrics, plan_path: str, comparison=None) -> dict:
+    """The result record written by ``--json``; ``comparison`` is the run's end against
+    the plan (`execute.validate.plan_compare`), when computed."""
+    v = run.verdict
+    f = v.failure
+    pe = run.options.placement
+    return {
+        "plan": plan_path,
+        "verdict": "climbed" if v.climbed else "failed",
+        "cause": None if f is None else f.cause,
+        "time_s": run.simulated_s if f is None else f.time_s,
+        "line": int(run.log.line_index[-1]) + 1 if f is None else f.line,
+        "why": _why(run, metrics, comparison),
+        "details": {} if f is None else f.details,
+        "final_holds": v.final_holds,
+        "strategy": run.options.strategy,
+        "battery_v": run.options.board.battery_v,
+        "placement_error": {"dx_m": pe.dx_m, "dy_m": pe.dy_m, "dyaw_rad": pe.dyaw_rad},
+        "board_trips": [str(t) for t in run.log.trips],
+        "grasp_events": [str(g) for g in run.log.grasps],
+        "metrics": metrics.to_json(),
+        "plan_vs_sim": None if comparison is None else comparison.to_json(),
+    }
+
+
+def _run(args: argparse.Namespace) -> int:
+    from daemon.sim.board_model import BoardModelConfig, PlacementError
+    from execute.validate.metrics import compute_metrics
+    from execute.validate.plan_compare import compare_with_plan
+    from execute.validate.simulate import SimulationOptions, simulate
+    from ladders.loader import load_ladder
+    from robot.plan_sidecar import read_sidecar, sidecar_path
+    from robot.trajectory_file import read_trajectory
+
+    plan = Path(args.plan)
+    side = sidecar_path(plan)
+    if not side.exists():
+        raise InputError(f"{side}: no plan sidecar next to {plan}; validate-plan needs the "
+                         "holds and arm schedule that plan-ladder writes")
+    sidecar = read_sidecar(side)
+    robot = args.robot or sidecar.robot
+    traj = read_trajectory(plan, sidecar.rate_hz, robot)
+    if len(traj) != sidecar.line_count:
+        raise InputError(f"{plan}:{len(traj)}: the file has {len(traj)} lines, its sidecar "
+                         f"{side} says {sidecar.line_count}")
+    ladder = load_ladder(args.ladder) if args.ladder else ladder_from_sidecar(
+        sidecar.ladder, f"{side}: ladder")
+    board_cfg = BoardModelConfig(battery_v=args.battery)
+    opts = SimulationOptions(strategy=args.strategy,
+                             placement=PlacementError.parse(args.placement_error),
+                             board=board_cfg)
+    run = simulate(traj, sidecar, ladder, opts, robot)
+    metrics = compute_metrics(run)
+    comparison = compare_with_plan(run, traj, ladder)
+    result = result_json(run, metrics, str(plan), comparison)
+    print(f"{result['verdict']}: {result['why']}")
+    print(f"simulated {metrics.simulated_s:.2f} s at {metrics.real_time_factor:.1f}× real "
+          f"time")
+    if args.json:
+        Path(args.json).write_text(json.dumps(result, indent=1))
+    if args.plots or args.video:
+        from execute.validate.artifacts import (
+            RenderingUnavailable,
+            write_plan_comparison_plot,
+            write_snapshot_strip,
+            write_tracking_plots,
+            write_video,
+        )
+        try:
+            if args.plots:
+                for p in write_tracking_plots(run, args.plots):
+                    print(f"wrote {p}")
+                if comparison is not None:
+                    path = write_plan_comparison_plot(run, comparison, traj, ladder,
+                                                      Path(args.plots) / "plan_vs_sim.png")
+                    print(f"wrote {path}")
+                print(f"wrote {write_snapshot_strip(run, Path(args.plots) / 'snapshots.png')}")
+            if args.video:
+                print(f"wrote {write_video(run, args.video)}")
+        except RenderingUnavailable as exc:
+            print(f"validate-plan: no rendering: {exc}", file=sys.stderr)
+    return 0 if run.verdict.climbed else 1
+
+
+def _joined_negative_values(argv: list[str]) -> list[str]:
+    """``--placement-error -0.03,0,0`` as ``--placement-error=-0.03,0,0``: argparse takes
+    a token that starts with '-' and is not a plain number for an option."""
+    out: list[str] = []
+    for token in argv:
+        if out and out[-1] == "--placement-error" and token.startswith("-"):
+            out[-1] = f"--placement-error={token}"
+        else:
+            out.append(token)
+    return out
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of ``validate-plan``; returns the exit code."""
+    parser = _parser()
+    args = parser.parse_args(_joined_negative_values(sys.argv[1:] if argv is None else argv))
+    if args.plots or args.video:
+        os.environ.setdefault("MUJOCO_GL", "egl")  # before mujoco is imported
+    logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
+                        format="%(name)s: %(message)s")
+    return run_cli("validate-plan", lambda: _run(args))
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,147 @@
+"""How much torque each arm joint can give while its hand holds a rail, per strategy.
+
+The torque LP of `planner.statics.stability` spreads the load over every joint that can carry
+it. Which arm joints can carry how much depends on how the arms will be driven:
+
+- ``position``: both arms rigid; every joint up to its torque limit.
+- ``mixed`` (the thesis's best strategy, the default): an arm whose hand holds a rail is
+  in PWM compliance. Its joints give at most the stall torque of their motor at the PWM
+  clamp of the default gains, ``|η·gear·Kt·V·max_pwm/(100·R)|`` (`robot.motors`,
+  `robot.pwm_gains`): at 48 V about 14 N·m at the shoulders, 5.8–7.2 N·m at the elbows
+  and 1.4 N·m at the wrist pitch, against 27, 23 and 8.9 N·m rigid. The wrist roll
+  cannot be compliant (it sits on the finger board) and keeps its limit.
+
+A plan made for ``position`` arms asks the compliant arms of ``mixed`` for torque they do
+not have: the legs then saturate and their boards trip (validate-plan shows it).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+from functools import lru_cache
+from types import MappingProxyType
+
+import numpy as np
+
+from planner.contacts import Stance
+from robot.joints import ARM_JOINTS, JOINT_INDEX
+from robot.motors import DEFAULT_BATTERY_V, motor_table
+from robot.pwm_gains import safe_default_gain_table
+
+__all__ = ["ARM_STRATEGIES", "BACK_EMF_SHARE", "DEFAULT_ARM_STRATEGY",
+           "DEFAULT_POSITION_TORQUE_SHARE",
+           "arms_comply_while_gripping", "balance_stance", "compliant_speed_rad_s",
+           "compliant_torque_nm",
+           "gripping_sides", "gripping_torque_limits", "gripping_velocity_limits"]
+
+ARM_STRATEGIES = ("mixed", "position")
+#: Share of its torque limit a joint in position mode (the legs, the waist, a rigid arm)
+#: is planned to. The torque LP chooses how the legs and the compliant arms share the
+#: load, but a compliant arm gives what its feed-forward and its stiffness towards the
+#: reference make, and a position-controlled leg takes the rest: at the DRC mount's
+#: lift-off the left hand pulled 48 N towards the ladder in MuJoCo where the LP had 61 N,
+#: and the left knee, planned at 0.96–0.99 of its limit, saturated and its board
+#: tripped. Of mount-only DRC plans (seeds 1–16), MuJoCo climbed 5 at 1.0 (10 of the 11
+#: failures knee trips) and 7 at 0.9 (no knee trip; 4 hip-roll trips and 5 grips lost);
+#: the reserve removes the knee's failure, not the others, and 7 against 5 of 16 is
+#: within chance. The value is a choice.
+DEFAULT_POSITION_TORQUE_SHARE = 0.9
+DEFAULT_ARM_STRATEGY = "mixed"
+#: Share of a compliant joint's PWM clamp its back-EMF may take while it moves: a PWM arm
+#: on a rail is moved by the body at a speed its motor must follow, and the duty that
+#: overcomes the back-EMF is duty the arm's load cannot have.
+BACK_EMF_SHARE = 0.25
+
+
+def arms_comply_while_gripping(strategy: str) -> bool:
+    """Whether ``strategy`` puts an arm whose hand holds a rail in PWM compliance.
+
+    Raises:
+        ValueError: an unknown strategy.
+    """
+    if strategy not in ARM_STRATEGIES:
+        raise ValueError(f"unknown arm strategy {strategy!r}; use one of {ARM_STRATEGIES}")
+    return strategy != "position"
+
+
+def balance_stance(stance: Stance, strategy: str = DEFAULT_ARM_STRATEGY) -> Stance:
+    """The holds the CoM's static balance may rely on.
+
+    A hand whose arm is the only compliant one gripping carries load but does not hold
+    the balance: the feet must. One PWM arm is a soft spring (its pull grows by the
+    reference error times kp), too soft against the body tipping about the feet's edge.
+    In MuJoCo, DRC seed 1's plan released the left hand on rung 0 with the CoM 9 mm
+    behind the rung's rear edge and the right hand planned to pull 10 N; the body tipped
+    back 10 cm in 2.4 s while that hand's pull grew from 6 to 33 N, until the grip let
+    go. Two compliant arms (the DRC mount, 15 of 16 seeds) and a rigid arm hold it.
+    """
+    hands = [h for h in stance.holds if h.is_hand]
+    feet = tuple(h for h in stance.holds if not h.is_hand)
+    if len(hands) != 1 or not feet or not arms_comply_while_gripping(strategy):
+        return stance
+    return Stance(feet)
+
+
+@lru_cache(maxsize=16)
+def compliant_torque_nm(battery_v: float = DEFAULT_BATTERY_V) -> Mapping[str, float]:
+    """Stall torque at the default gains' PWM clamp, per compliant joint [N·m]."""
+    per_duty = np.abs(motor_table().torque_per_duty(battery_v))
+    return MappingProxyType({
+        name: float(per_duty[JOINT_INDEX[name]] * max_pwm)
+        for name, (_, _, max_pwm) in safe_default_gain_table().items() if max_pwm > 0})
+
+
+@lru_cache(maxsize=16)
+def compliant_speed_rad_s(battery_v: float = DEFAULT_BATTERY_V) -> Mapping[str, float]:
+    """Speed at which a compliant joint's back-EMF takes `BACK_EMF_SHARE` of its PWM
+    clamp, ``share · τ_clamp / b`` (b: back-EMF damping, `robot.motors`) [rad/s]."""
+    damping = motor_table().back_emf_damping
+    return MappingProxyType({
+        name: BACK_EMF_SHARE * torque / float(damping[JOINT_INDEX[name]])
+        for name, torque in compliant_torque_nm(battery_v).items()})
+
+
+def gripping_velocity_limits(nominal_rad_s: np.ndarray, sides: Iterable[str],
+                             strategy: str = DEFAULT_ARM_STRATEGY,
+                             battery_v: float = DEFAULT_BATTERY_V) -> np.ndarray | None:
+    """Velocity limits (40,) [rad/s] while the arms of ``sides`` hold rails and
+    ``strategy`` drives them: the nominal ones, the compliant arms' joints capped at
+    `compliant_speed_rad_s`; None when nothing is capped."""
+    if not arms_comply_while_gripping(strategy) or not sides:
+        return None
+    limits = np.array(nominal_rad_s, dtype=float)
+    speed = compliant_speed_rad_s(battery_v)
+    for side in sides:
+        for name in ARM_JOINTS[side]:
+            if name in speed:
+                j = JOINT_INDEX[name]
+                limits[j] = min(limits[j], speed[name])
+    return limits
+
+
+def gripping_sides(limbs: Iterable[str]) -> frozenset[str]:
+    """The arms ("left"/"right") whose hands are among ``limbs`` (limb names)."""
+    return frozenset(limb.removesuffix("_hand") for limb in limbs if limb.endswith("_hand"))
+
+
+def gripping_torque_limits(torque_max_nm: Mapping[str, float], sides: Iterable[str],
+                           strategy: str = DEFAULT_ARM_STRATEGY,
+                           battery_v: float = DEFAULT_BATTERY_V,
+                           position_share: float = 1.0) -> dict[str, float]:
+    """Torque limits by joint [N·m] with the arms of ``sides`` ("left"/"right") driven as
+    ``strategy`` drives a gripping arm.
+
+    Joints in position mode get ``position_share`` of their limit (the planner's reserve
+    for their loops, `planner.search.PlannerConfig.position_torque_share`); a compliant
+    joint's PWM clamp is its ceiling in the plan and on the robot alike, and is not
+    shared.
+    """
+    limits = {name: tau * position_share for name, tau in torque_max_nm.items()}
+    if not arms_comply_while_gripping(strategy):
+        return limits
+    compliant = compliant_torque_nm(battery_v)
+    for side in sides:
+        for name in ARM_JOINTS[side]:
+            if name in compliant and name in limits:
+                limits[name] = min(torque_max_nm[name], compliant[name])
+    return limits

@@ -1,0 +1,442 @@
+"""A kinematic verifier of a planned climb, independent of the planner (``check-plan``'s
+library; the command line is `planner.verify.cli`).
+
+It trusts only the two files and the robot and ladder descriptions: no search, no IK, no
+planner state. For every line it rebuilds the floating base from a foot the sidecar
+says is in contact (its sole frame at the hold's position, flat on its tread: the
+ladder's orientation on a rung, level on the floor), then checks:
+
+- joint limits (the robot's position limits);
+- joint speed between consecutive lines (nominal limits ×1.0 at the file rate);
+- holds: every limb the sidecar says is in contact has its frame within `HOLD_TOL_M` of
+  the recorded hold, and the recorded hold lies within `HOLD_TOL_M` of its rung's tread,
+  its rail's axis or the floor;
+- collisions (coal, robot and ladder primitives; a limb's end links may touch what it
+  holds, and a moving limb what it leaves in the first half of its segment and what it
+  reaches in the second);
+- static stability with the holds in contact: the CoM inside the support region
+  (friction cones, Bretl–Lall) of the holds that may balance it (a lone compliant hand
+  may not, `planner.statics.arm_capacity.balance_stance`) and the joint torques within limits
+  (LP), an arm whose hand holds a rail limited to what the sidecar's arm strategy lets it
+  give.
+
+`check_plan` returns, per check, the worst line and whether any line fails.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from types import SimpleNamespace
+from typing import TYPE_CHECKING, NamedTuple
+
+import numpy as np
+
+from planner.holds import half_tread_m, sole_contact_points
+from planner.statics.arm_capacity import balance_stance, gripping_sides, gripping_torque_limits
+from robot.errors import InputError
+from robot.plan_sidecar import PlanSidecar, Segment
+
+if TYPE_CHECKING:
+    from planner.contacts import Stance
+    from planner.statics.stability import SupportRegion, TorqueCheck
+
+__all__ = ["CHECKS", "CheckResult", "HOLD_TOL_M", "PlannedLoad", "allowed_contacts", "check_plan",
+           "planned_loads"]
+
+log = logging.getLogger(__name__)
+
+#: A limb in contact must stay this close to its hold, and a hold to its rung/rail [m].
+HOLD_TOL_M = 0.01
+#: Slack on joint limits for values written by a float formatter [rad].
+LIMIT_TOL_RAD = 1e-9
+#: Clearance (a slow distance query) is measured on every this-many-th line.
+CLEARANCE_EVERY_LINES = 20
+CHECKS = ("joint limits", "velocity", "holds", "collision", "stability margin",
+          "torque ratio")
+_FRAME = {"left_hand": "L_palm", "right_hand": "R_palm", "left_foot": "L_sole",
+          "right_foot": "R_sole"}
+
+
+@dataclass
+class CheckResult:
+    """The outcome of one check over all lines.
+
+    Attributes:
+        name: one of `CHECKS`.
+        ok: every checked line passed.
+        worst_line: 1-based line with the worst value (0: nothing checked).
+        value: the worst value, in ``unit``.
+        limit: the value it must stay within, in ``unit``.
+        unit: unit of ``value`` and ``limit``.
+        detail: what the worst line is (segment, joint, limb, pair).
+        failing_lines: how many lines fail.
+    """
+
+    name: str
+    ok: bool = True
+    worst_line: int = 0
+    value: float = float("nan")
+    limit: float = float("nan")
+    unit: str = ""
+    detail: str = ""
+    failing_lines: int = 0
+    _worst_key: float = field(default=-math.inf, repr=False)
+
+    def offer(self, line: int, key: float, value: float, detail: str, failed: bool) -> None:
+        """Record a line's value; ``key`` orders badness (larger is worse)."""
+        self.failing_lines += int(failed)
+        self.ok &= not failed
+        if key > self._worst_key:
+            self._worst_key, self.worst_line, self.value, self.detail = key, line, value, detail
+
+
+def allowed_contacts(segments: Sequence[Segment], index: int, fraction: float
+                     ) -> dict[str, str]:
+    """Which environment object each limb may touch at a point of a sidecar segment.
+
+    A held limb touches its hold's target. A moving limb may touch the object it left
+    during the first half of the segment and the one it will hold during the second
+    (a foot lifting off a rung, a hand closing in on a rail).
+
+    Args:
+        segments: the sidecar's segments.
+        index: the segment.
+        fraction: how far into the segment, 0 (first line) to 1 (last line).
+
+    Returns:
+        limb → environment object name (``floor``, ``rung_3``, ``rail_left``...).
+    """
+    seg = segments[index]
+    contacts = {limb: h.target for limb, h in seg.holds.items()}
+    for limb in seg.moving_limbs:
+        before = next((s.holds[limb].target for s in reversed(segments[:index])
+                       if limb in s.holds), None)
+        after = next((s.holds[limb].target for s in segments[index + 1:] if limb in s.holds),
+                     None)
+        choice = (before or after) if fraction < 0.5 else (after or before)
+        if choice is not None:
+            contacts[limb] = choice
+    return contacts
+
+
+class _SegmentStance(NamedTuple):
+    """A segment's holds as the checks use them (`_Verifier.stance`)."""
+
+    stance: Stance
+    region: SupportRegion  # the CoM's, on the holds that may balance it
+    torque_limits: dict[str, float]  # [N·m]
+    balance_limbs: tuple[str, ...]  # those holds (`planner.statics.arm_capacity.balance_stance`)
+
+
+class _Verifier:
+    """The robot and ladder models the checks run on."""
+
+    def __init__(self, spec, robot: str, arm_strategy: str):
+        import pinocchio as pin
+
+        from ladders.collision import ladder_collision_objects
+        from ladders.geometry import LadderGeometry
+        from planner.configuration.collision import CollisionModel
+        from planner.statics.stability import torque_limits_by_joint
+        from robot.joints import JOINT_NAMES
+        from robot.params import robot_params
+        from robot.urdf import robot_urdf
+
+        self.pin = pin
+        self.params = robot_params(robot)
+        self.spec = spec
+        self.geom = LadderGeometry(spec)
+        self.model = pin.buildModelFromXML(robot_urdf(self.params), pin.JointModelFreeFlyer())
+        self.data = self.model.createData()
+        self.q_index = np.array([self.model.joints[self.model.getJointId(n)].idx_q
+                                 if self.model.existJointName(n) else -1
+                                 for n in JOINT_NAMES])
+        self.frame_id = {limb: self.model.getFrameId(f) for limb, f in _FRAME.items()}
+        robot_view = SimpleNamespace(model=self.model, data=self.data, params=self.params)
+        self.collision = CollisionModel(robot_view, ladder_collision_objects(spec))
+        self.torque_max = torque_limits_by_joint(self.params.name)
+        self.arm_strategy = arm_strategy
+        self._stances: dict[int, tuple] = {}  # segment index → stance, region, limits
+
+    # ---------------------------------------------------------------- configuration
+    def sole_rotation(self, target: str) -> np.ndarray:
+        return np.eye(3) if target == "floor" else self.geom.R_world_ladder
+
+    def configuration(self, columns: np.ndarray, seg: Segment) -> np.ndarray | None:
+        """Full configuration of a line, the base placed from a foot in contact."""
+        pin = self.pin
+        ref = next((lb for lb in ("left_foot", "right_foot") if lb in seg.holds), None)
+        if ref is None:
+            return None
+        q = pin.neutral(self.model)
+        have = self.q_index >= 0
+        q[self.q_index[have]] = columns[have]
+        pin.framesForwardKinematics(self.model, self.data, q)  # base at the origin
+        T_base_sole = self.data.oMf[self.frame_id[ref]].homogeneous
+        hold = seg.holds[ref]
+        T_world_sole = np.eye(4)
+        T_world_sole[:3, :3] = self.sole_rotation(hold.target)
+        T_world_sole[:3, 3] = hold.position_m
+        T_world_base = T_world_sole @ np.linalg.inv(T_base_sole)
+        q[:3] = T_world_base[:3, 3]
+        q[3:7] = pin.Quaternion(T_world_base[:3, :3]).coeffs()  # x y z w
+        pin.framesForwardKinematics(self.model, self.data, q)
+        return q
+
+    # ---------------------------------------------------------------- holds
+    def target_distance(self, target: str, p: np.ndarray) -> float:
+        """How far a recorded hold position lies from its object [m]."""
+        if target == "floor":
+            return abs(float(p[2]))
+        if target.startswith("rail_"):
+            side = target.removeprefix("rail_")
+            return float(np.linalg.norm(p - self.geom.closest_rail_point(side, p)))
+        if target.startswith("rung_"):
+            i = int(target.removeprefix("rung_"))
+            s = self.spec
+            top = self.geom.to_ladder(self.geom.rung_top_centres_m[i])
+            d = self.geom.to_ladder(p) - top
+            # The sole overlaps the tread: its centre within half a foot of the tread.
+            half_along = half_tread_m(s) + self.params.foot_length_m / 2
+            excess = np.array([max(0.0, abs(d[0]) - half_along),
+                               max(0.0, abs(d[1]) - s.rung_width_m / 2), d[2]])
+            return float(np.linalg.norm(excess))
+        raise InputError(f"hold target {target!r} is not 'floor', 'rung_<i>' or "
+                         "'rail_left'/'rail_right'")
+
+    def frame_position(self, limb: str) -> np.ndarray:
+        return self.data.oMf[self.frame_id[limb]].translation.copy()
+
+    # ---------------------------------------------------------------- stability
+    def contact_hold(self, limb: str, record) -> object:
+        """The contact model of a recorded hold (sole corners on the tread, or a palm
+        pushing up and pulling towards the ladder)."""
+        from planner.contacts import Hold
+
+        p = np.asarray(record.position_m, dtype=float)
+        mu = self.spec.friction
+        up = np.array([0.0, 0.0, 1.0])
+        T = np.eye(4)
+        T[:3, 3] = p
+        if limb.endswith("hand"):
+            towards = self.geom.R_world_ladder[:, 0]
+            return Hold(limb, record.target, T, np.vstack([p, p]), np.vstack([up, towards]), mu)
+        R = self.sole_rotation(record.target)
+        T[:3, :3] = R
+        hl = self.params.foot_length_m / 2
+        x0, x1 = -hl, hl
+        if record.target.startswith("rung_"):
+            top = self.geom.rung_top_centres_m[int(record.target.removeprefix("rung_"))]
+            # Tread centre along the sole's x axis, relative to the sole frame.
+            c = float(R[:, 0] @ (top - p))
+            half = half_tread_m(self.spec)
+            x0, x1 = max(-hl, c - half), min(hl, c + half)
+            if x1 <= x0:
+                x0 = x1 = float(np.clip(c, -hl, hl))
+        # The whole support: check-plan verifies the physics, not the planner's margin.
+        pts = sole_contact_points(self.params, T, (x0, x1), margin_m=0.0)
+        return Hold(limb, record.target, T, pts, np.tile(up, (4, 1)), mu)
+
+    def stance(self, seg_index: int, seg: Segment) -> _SegmentStance:
+        """The stance of a segment, its support region and its joint torque limits [N·m]
+        (arms whose hands hold a rail driven as the plan's arm strategy drives them; the
+        planner's capacity model is robot data), cached."""
+        if seg_index not in self._stances:
+            from planner.contacts import Stance
+            from planner.statics.stability import support_region
+
+            stance = Stance(tuple(self.contact_hold(lb, h) for lb, h in sorted(seg.holds.items())))
+            limits = gripping_torque_limits(self.torque_max, gripping_sides(seg.holds),
+                                            self.arm_strategy)
+            balance = balance_stance(stance, self.arm_strategy)
+            self._stances[seg_index] = _SegmentStance(
+                stance, support_region(balance, self.params.total_mass_kg), limits,
+                tuple(sorted(balance.limbs)))
+        return self._stances[seg_index]
+
+
+def _segment_of_lines(sidecar: PlanSidecar, where: str) -> np.ndarray:
+    index = np.full(sidecar.line_count, -1)
+    for k, seg in enumerate(sidecar.segments):
+        index[seg.first_line - 1:seg.last_line] = k
+    missing = np.flatnonzero(index < 0)
+    if len(missing):
+        raise InputError(f"{where}: field 'segments' does not cover line {missing[0] + 1}")
+    return index
+
+
+@dataclass(frozen=True, eq=False)
+class PlannedLoad:
+    """The plan's account of one line: where the body is and how it carries its weight.
+
+    Attributes:
+        line: the line (1-based).
+        base_pose: (4, 4) world pose of the robot's root link, placed from a held foot.
+        torque: the torque LP on the line's holds (check-plan's limits and contacts):
+            joint torques and the contact forces on each held limb; None when the line
+            has no foot in contact to place the body from.
+    """
+
+    line: int
+    base_pose: np.ndarray | None
+    torque: TorqueCheck | None
+
+
+def planned_loads(traj_rad: np.ndarray, sidecar: PlanSidecar, spec, lines: Sequence[int],
+                  robot: str | None = None) -> list[PlannedLoad]:
+    """The configuration and the torque LP of each of ``lines`` (1-based), as check-plan
+    computes them: what a simulation of the plan is compared against."""
+    from planner.statics.stability import torque_feasibility
+
+    seg_of = _segment_of_lines(sidecar, "plan")
+    v = _Verifier(spec, robot or sidecar.robot, sidecar.metrics.get("arm_strategy",
+                                                                     "position"))
+    out = []
+    for line in lines:
+        si = int(seg_of[line - 1])
+        seg = sidecar.segments[si]
+        q = v.configuration(traj_rad[line - 1], seg)
+        if q is None:
+            out.append(PlannedLoad(line, None, None))
+            continue
+        held = v.stance(si, seg)
+        torque = torque_feasibility(v.model, v.data, q, held.stance, held.torque_limits,
+                                    v.frame_id)
+        base = np.eye(4)
+        base[:3, :3] = v.pin.Quaternion(q[6], q[3], q[4], q[5]).toRotationMatrix()
+        base[:3, 3] = q[:3]
+        out.append(PlannedLoad(line, base, torque))
+    return out
+
+
+def check_plan(traj_rad: np.ndarray, sidecar: PlanSidecar, spec, robot: str | None = None,
+               rate_hz: float | None = None, every: int = 1, where: str = "plan"
+               ) -> list[CheckResult]:
+    """Run every check on a trajectory and its sidecar.
+
+    Args:
+        traj_rad: (N, 40) trajectory lines [rad] (not necessarily within limits).
+        sidecar: its sidecar.
+        spec: the `LadderSpec` the plan climbs.
+        robot: robot name; the sidecar's if None.
+        rate_hz: playback rate [Hz]; the sidecar's if None.
+        every: check collisions and stability on every n-th line only (and on the
+            first and last line of every segment); limits and holds are always checked
+            on every line.
+        where: the plan's name, for messages.
+
+    Returns:
+        One result per check, in `CHECKS` order.
+
+    Raises:
+        InputError: the sidecar and the trajectory disagree (line count, coverage).
+    """
+    from planner.statics.stability import check_stability
+    from robot.joints import JOINT_NAMES
+    from robot.limits import joint_limits
+
+    robot = robot or sidecar.robot
+    rate_hz = float(rate_hz or sidecar.rate_hz)
+    # The torque a gripping arm may carry depends on how it will be driven; a sidecar from
+    # before the strategy was recorded was planned with rigid arms.
+    arm_strategy = sidecar.metrics.get("arm_strategy", "position")
+    n = len(traj_rad)
+    if n != sidecar.line_count:
+        raise InputError(f"{where}: the trajectory has {n} lines, its sidecar's field "
+                         f"'line_count' says {sidecar.line_count}")
+    seg_of = _segment_of_lines(sidecar, where)
+    segs = sidecar.segments
+    v = _Verifier(spec, robot, arm_strategy)
+    lim = joint_limits(robot)
+    res = {c: CheckResult(c) for c in CHECKS}
+    res["joint limits"].limit, res["joint limits"].unit = 0.0, "rad past limit"
+    res["velocity"].limit, res["velocity"].unit = 1.0, "× nominal"
+    res["holds"].limit, res["holds"].unit = HOLD_TOL_M, "m"
+    res["collision"].limit, res["collision"].unit = 0.0, "m clearance"
+    res["stability margin"].limit, res["stability margin"].unit = 0.0, "m"
+    res["torque ratio"].limit, res["torque ratio"].unit = 1.0, "× limit"
+
+    # Joint limits and speeds: whole-array checks.
+    beyond = np.maximum(lim.lower_rad - traj_rad, traj_rad - lim.upper_rad)
+    for k in np.argsort(-beyond.max(axis=1))[:1].tolist() + \
+            np.flatnonzero(beyond.max(axis=1) > LIMIT_TOL_RAD).tolist():
+        j = int(np.argmax(beyond[k]))
+        res["joint limits"].offer(k + 1, beyond[k, j], float(beyond[k, j]),
+                                  f"{JOINT_NAMES[j]} = {traj_rad[k, j]:.4f} rad, limits "
+                                  f"[{lim.lower_rad[j]:.4g}, {lim.upper_rad[j]:.4g}]",
+                                  bool(beyond[k, j] > LIMIT_TOL_RAD))
+    if n > 1:
+        ratio = np.abs(np.diff(traj_rad, axis=0)) * rate_hz / lim.velocity_nominal_rad_s
+        worst = ratio.max(axis=1)
+        for k in [int(np.argmax(worst))] + np.flatnonzero(worst > 1.0 + 1e-9).tolist():
+            j = int(np.argmax(ratio[k]))
+            vnom = lim.velocity_nominal_rad_s[j]
+            res["velocity"].offer(k + 2, ratio[k, j], float(ratio[k, j]),
+                                  f"{JOINT_NAMES[j]} at {ratio[k, j] * vnom:.3g} rad/s "
+                                  f"(nominal {vnom:.3g})",
+                                  bool(ratio[k, j] > 1.0 + 1e-9))
+    else:
+        res["velocity"].value = 0.0
+
+    # Per line: base from a foot, holds, collisions, stability.
+    prev_key = None
+    prev_out: tuple | None = None
+    for k in range(n):
+        line = k + 1
+        si = int(seg_of[k])
+        seg = segs[si]
+        label = f"{seg.primitive}/{seg.phase}"
+        q = v.configuration(traj_rad[k], seg)
+        if q is None:
+            res["holds"].offer(line, math.inf, math.inf, f"{label}: no foot in contact: the "
+                               "base cannot be placed", True)
+            continue
+        hold_err, hold_what = 0.0, ""
+        for limb, h in seg.holds.items():
+            p = np.asarray(h.position_m)
+            d_frame = float(np.linalg.norm(v.frame_position(limb) - p))
+            d_target = v.target_distance(h.target, p)
+            if max(d_frame, d_target) >= hold_err:
+                hold_err = max(d_frame, d_target)
+                hold_what = (f"{label}: {limb} {d_frame * 100:.2f} cm from its hold on "
+                             f"{h.target}, hold {d_target * 100:.2f} cm from {h.target}")
+        res["holds"].offer(line, hold_err, hold_err, hold_what, hold_err > HOLD_TOL_M)
+        at_end = line in (seg.first_line, seg.last_line)
+        if every > 1 and (line - seg.first_line) % every and not at_end:
+            continue
+        key = (si, traj_rad[k].tobytes())
+        if key == prev_key and prev_out is not None:  # a dwell line: same as before
+            out = prev_out
+        else:
+            frac = (line - seg.first_line) / max(1, seg.last_line - seg.first_line)
+            v.collision.allow(allowed_contacts(segs, si, frac))
+            hit = v.collision.in_collision(q)
+            clear, pair = math.nan, ""
+            if hit or (line - 1) % CLEARANCE_EVERY_LINES == 0:
+                rep = v.collision.report(q)
+                clear, pair = rep.min_distance_m, " – ".join(rep.closest_pair)
+            held = v.stance(si, seg)
+            rep_s = check_stability(v.model, v.data, q, held.stance, held.region,
+                                    held.torque_limits)
+            tq = rep_s.torque
+            out = (hit, clear, pair, rep_s.margin_m,
+                   math.inf if tq is None else tq.max_ratio, "" if tq is None else tq.worst_joint,
+                   tq is not None and tq.feasible)
+            prev_key, prev_out = key, out
+        hit, clear, pair, margin, ratio_t, joint, feasible = out
+        if hit or not math.isnan(clear):
+            d = clear if not math.isnan(clear) else 0.0
+            res["collision"].offer(line, -d + (1.0 if hit else 0.0), d,
+                                   f"{label}: {pair or 'in collision'}", hit)
+        balance = v.stance(si, seg).balance_limbs
+        res["stability margin"].offer(line, -margin, margin,
+                                      f"{label}: CoM margin {margin * 100:.1f} cm in the "
+                                      f"support region of {', '.join(balance)}",
+                                      margin < 0.0)
+        if margin >= 0.0:
+            res["torque ratio"].offer(line, ratio_t, ratio_t, f"{label}: worst joint {joint}",
+                                      not feasible)
+    return [res[c] for c in CHECKS]

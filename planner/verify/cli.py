@@ -1,0 +1,121 @@
+"""``check-plan``: a kinematic verifier of a planned climb, independent of the planner.
+
+    check-plan OUT.traj [--ladder L] [--robot R] [--rate HZ] [--every N]
+
+It checks every line with `planner.verify.check.check_plan` (see there for the checks).
+It prints the worst line of each check and exits 0 when all pass, 1 when one fails,
+2 on bad input (the message names the file and the field or line).
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from planner.verify.check import CheckResult, check_plan
+from robot.errors import HuboLadderError, InputError, TrajectoryFileError
+from robot.plan_sidecar import PlanSidecar
+
+__all__ = ["main"]
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="check-plan", description=__doc__.split("\n\n")[0])
+    p.add_argument("plan", help="the trajectory (OUT.traj); OUT.plan.json must sit next to it")
+    p.add_argument("--ladder", help="ladder name or spec file (default: the sidecar's)")
+    p.add_argument("--robot", choices=("drc-hubo", "hubo2plus"),
+                   help="robot (default: the sidecar's)")
+    p.add_argument("--rate", type=float, metavar="HZ", help="file rate (default: the "
+                   "sidecar's)")
+    p.add_argument("--every", type=int, default=1, metavar="N",
+                   help="check collisions and stability on every N-th line (default 1)")
+    return p
+
+
+def _read(path: Path, rate_hz: float, robot: str) -> np.ndarray:
+    """Read a trajectory: format errors are bad input; joint values beyond the limits
+    are read anyway (the joint-limit check reports them)."""
+    from robot.trajectory_file import read_trajectory
+
+    try:
+        return read_trajectory(path, rate_hz, robot, check_speed=False)
+    except TrajectoryFileError as exc:
+        if not all("outside the joint limits" in p for p in exc.problems):
+            raise
+    return np.loadtxt(path, ndmin=2)
+
+
+def _ladder(args, sidecar: PlanSidecar, where: str):
+    import yaml
+
+    from ladders.loader import load_ladder, parse_ladder_yaml
+
+    if args.ladder:
+        return load_ladder(args.ladder)
+    return parse_ladder_yaml(yaml.safe_dump(sidecar.ladder), f"{where}: field 'ladder'")
+
+
+def _table(results: list[CheckResult], title: str):
+    from rich.table import Table
+
+    t = Table(title=title)
+    for col in ("check", "result", "worst line", "value", "limit", "where"):
+        t.add_column(col, justify="right" if col in ("worst line", "value", "limit") else "left")
+    for r in results:
+        t.add_row(r.name, "[green]pass[/]" if r.ok else f"[red]FAIL[/] ({r.failing_lines} lines)",
+                  str(r.worst_line) if r.worst_line else "–", f"{r.value:.4g} {r.unit}",
+                  f"{r.limit:g}", r.detail)
+    return t
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of ``check-plan``; returns the exit code."""
+    from rich.console import Console
+
+    from robot.plan_sidecar import read_sidecar, sidecar_path
+
+    try:
+        args = _parser().parse_args(argv)
+    except SystemExit as exc:
+        return int(exc.code or 0)
+    err = Console(stderr=True)
+    logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
+    path = Path(args.plan)
+    try:
+        if args.every < 1:
+            raise InputError(f"--every must be ≥ 1, got {args.every}")
+        side = sidecar_path(path)
+        if not side.exists():
+            raise InputError(f"{path}: its sidecar {side} is missing")
+        sidecar = read_sidecar(side)
+        robot = args.robot or sidecar.robot
+        rate = args.rate or sidecar.rate_hz
+        spec = _ladder(args, sidecar, str(side))
+        traj = _read(path, rate, robot)
+        results = check_plan(traj, sidecar, spec, robot, rate, args.every, str(path))
+    except InputError as exc:
+        err.print(f"check-plan: {exc}", markup=False, highlight=False, soft_wrap=True)
+        return 2
+    except HuboLadderError as exc:
+        err.print(f"check-plan: {exc}", markup=False, highlight=False, soft_wrap=True)
+        return 1
+    out = Console()
+    if not out.is_terminal:  # a log file or a pipe: keep each row on one line
+        out = Console(width=200)
+    out.print(_table(results, f"check-plan {path} ({len(traj)} lines, {spec.name}, {robot})"))
+    failed = [r for r in results if not r.ok]
+    if failed:
+        for r in failed:
+            err.print(f"check-plan: {r.name} fails at line {r.worst_line}: {r.detail}",
+                      markup=False, highlight=False, soft_wrap=True)
+        return 1
+    err.print(f"check-plan: all {len(results)} checks pass", highlight=False)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
