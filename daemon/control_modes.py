@@ -34,6 +34,7 @@ from enum import IntEnum
 
 import numpy as np
 
+from robot.constants import DAEMON_RATE_HZ, TICK_S  # re-exported: the daemon's rate
 from robot.errors import InputError
 from robot.joints import JOINT_NAMES, NUM_JOINTS
 
@@ -50,10 +51,6 @@ __all__ = [
     "ticks_to_settle",
     "validate_modes",
 ]
-
-DAEMON_RATE_HZ = 200  # [Hz] the daemon loop
-TICK_S = 1.0 / DAEMON_RATE_HZ  # [s] one daemon tick (5 ms)
-
 
 class RefMode(IntEnum):
     """Reference mode of one joint, as on the ``hubo-ref`` channel (hubo-ach numbering)."""

@@ -63,6 +63,7 @@ from daemon.structs import (
     BoardCommandType,
     StatusFlag,
 )
+from robot.constants import DAEMON_RATE_HZ
 from robot.errors import InputError
 from robot.joints import JOINT_INDEX, JOINT_NAMES, NECK_AND_WAIST, NUM_JOINTS
 from robot.pwm_gains import PWM_COMMAND_LIMIT_PCT
@@ -99,7 +100,7 @@ class LoopConfig:
         status_period_s: how often the status callback runs [s].
     """
 
-    rate_hz: float = 200.0
+    rate_hz: float = DAEMON_RATE_HZ
     watchdog_s: float = 0.2
     home_ignore_s: float = 3.0
     startup_ignore_s: float = 0.8

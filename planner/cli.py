@@ -27,6 +27,7 @@ from pathlib import Path
 
 from planner.holds import FOOT_COP_MARGIN_M, FOOT_FRICTION_SHARE
 from planner.statics.arm_capacity import DEFAULT_POSITION_TORQUE_SHARE
+from robot.constants import DAEMON_RATE_HZ
 from robot.errors import HuboLadderError, InputError
 
 __all__ = ["main"]
@@ -39,8 +40,8 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("ladder", help="bundled ladder name (drc, ship, stair) or a spec file")
     p.add_argument("--robot", default="drc-hubo", choices=("drc-hubo", "hubo2plus"))
     p.add_argument("--seed", type=int, default=1, help="random seed (default 1)")
-    p.add_argument("--rate", type=float, default=200.0, metavar="HZ",
-                   help="trajectory file rate [Hz] (default 200)")
+    p.add_argument("--rate", type=float, default=DAEMON_RATE_HZ, metavar="HZ",
+                   help=f"trajectory file rate [Hz] (default {DAEMON_RATE_HZ:g})")
     p.add_argument("-o", "--out", metavar="OUT.traj",
                    help="trajectory file (default: LADDER-NAME.traj); the sidecar "
                         "OUT.plan.json goes next to it")

@@ -27,6 +27,7 @@ import numpy as np
 import pinocchio as pin
 
 from planner.statics.arm_capacity import DEFAULT_ARM_STRATEGY, arms_comply_while_gripping
+from robot.constants import DAEMON_RATE_HZ
 from robot.joints import ARM_JOINTS
 from robot.plan_sidecar import (
     ArmFeedforward,
@@ -366,7 +367,7 @@ def _metrics(result: SearchResult, planner: ClimbPlanner, timed: TimedPlan,
 
 
 def write_plan(result: SearchResult, planner: ClimbPlanner, out_traj: str | os.PathLike,
-               rate_hz: float = 200.0, timings: dict[str, float] | None = None, *,
+               rate_hz: float = DAEMON_RATE_HZ, timings: dict[str, float] | None = None, *,
                dwell_s: float = 0.5, q_start: np.ndarray | None = None,
                clearance_every: int = CLEARANCE_EVERY_LINES) -> PlanOutput:
     """Time the plan, write ``OUT.traj`` and ``OUT.plan.json``.

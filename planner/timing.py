@@ -32,6 +32,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from robot.constants import DAEMON_RATE_HZ
 from robot.errors import HuboLadderError
 from robot.joints import JOINT_NAMES, NUM_JOINTS
 from robot.limits import JointLimits
@@ -80,7 +81,7 @@ class TimingConfig:
             samples break a limit.
     """
 
-    rate_hz: float = 200.0
+    rate_hz: float = DAEMON_RATE_HZ
     dwell_s: float = 0.5
     limit_scale: float = 0.9
     min_motion_rad: float = 1e-9

@@ -40,6 +40,7 @@ from daemon.can import protocol as cp
 from daemon.loop import BoardCommands, SensorFrame
 from daemon.structs import NUM_FT, NUM_IMU, BoardCommandType, StatusFlag
 from daemon.tables import JointTable, SensorTable, load_joint_table, load_sensor_table
+from robot.constants import GRAVITY_M_S2
 from robot.errors import InputError
 from robot.joints import NUM_JOINTS
 
@@ -138,7 +139,7 @@ class CanBackend:
         self._cur = np.zeros(NUM_JOINTS)
         self._ft = np.zeros((NUM_FT, 3))
         self._imu = np.zeros((NUM_IMU, 6))
-        self._imu[:, 2] = 9.81
+        self._imu[:, 2] = GRAVITY_M_S2
         self._power = np.zeros(3)
         self._seen = np.zeros(NUM_JOINTS, bool)
         self.no_reply_ticks = np.zeros(NUM_JOINTS, np.int64)  # per joint, since start

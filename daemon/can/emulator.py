@@ -29,6 +29,7 @@ import numpy as np
 from daemon.can import protocol as cp
 from daemon.structs import FT_NAMES, IMU_NAMES
 from daemon.tables import JointTable, SensorTable
+from robot.constants import GRAVITY_M_S2
 
 log = logging.getLogger(__name__)
 
@@ -240,7 +241,7 @@ class BoardEmulator:
         self._duty = np.zeros(n)  # [%]
         self._ft = np.zeros((len(FT_NAMES), 3))
         self._imu = np.zeros((len(IMU_NAMES), 6))
-        self._imu[:, 2] = 9.81
+        self._imu[:, 2] = GRAVITY_M_S2
         self._power = (48.0, 5.0)
         self._silent: set[tuple[int, bool, int]] = set()  # (bus, sensor?, board)
         self._bus_joints = {

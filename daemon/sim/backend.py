@@ -25,6 +25,7 @@ from daemon.loop import BoardCommands, SensorFrame
 from daemon.sim.board_model import TICK_S, BoardModel, BoardModelConfig
 from daemon.structs import BoardCommandType, StatusFlag
 from ladders.spec import LadderSpec
+from robot.constants import GRAVITY_M_S2
 from robot.joints import NUM_JOINTS
 
 __all__ = ["SimBackend"]
@@ -110,7 +111,7 @@ class SimBackend:
             s = self.board.state().sensors
             self._ft_offset = s.ft.copy()
             self._imu_offset = s.imu.copy()
-            self._imu_offset[:, 2] -= 9.81  # keep gravity on z: the robot hangs upright
+            self._imu_offset[:, 2] -= GRAVITY_M_S2  # keep gravity on z: the robot hangs upright
 
     def close(self) -> None:
         pass

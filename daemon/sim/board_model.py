@@ -51,6 +51,7 @@ from daemon.sim.grasp_latch import GraspEvent, GraspLatch, GripConfig
 from daemon.sim.sensors import SensorIndex, SensorReading, add_sensors, read_sensors
 from ladders.scene import build_scene
 from ladders.spec import LadderSpec
+from robot.constants import TICK_S
 from robot.errors import InputError
 from robot.joints import FINGER_JOINTS, JOINT_INDEX, JOINT_NAMES, NUM_JOINTS
 from robot.limits import joint_limits
@@ -61,9 +62,6 @@ __all__ = ["BoardModel", "BoardModelConfig", "BoardState", "PlacementError",
            "default_config"]
 
 log = logging.getLogger(__name__)
-
-TICK_S = 0.005  # [s] the daemon tick
-
 
 @dataclass(frozen=True)
 class PlacementError:

@@ -29,6 +29,7 @@ import sys
 import time
 from pathlib import Path
 
+from robot.constants import DAEMON_RATE_HZ
 from robot.errors import HuboLadderError, InputError
 
 __all__ = ["main", "parse_args"]
@@ -66,8 +67,8 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--top-rung", type=int, default=None, metavar="K",
                    help="climb until both feet are on rung K (default: the highest)")
     p.add_argument("--robot", default="drc-hubo", help="drc-hubo or hubo2plus")
-    p.add_argument("--rate", type=float, default=200.0, metavar="HZ",
-                   help="trajectory rate [Hz] (default 200)")
+    p.add_argument("--rate", type=float, default=DAEMON_RATE_HZ, metavar="HZ",
+                   help=f"trajectory rate [Hz] (default {DAEMON_RATE_HZ:g})")
     p.add_argument("--max-jobs", type=int, default=None, metavar="N",
                    help="run at most N jobs now, then stop (resume later)")
     p.add_argument("--no-plots", action="store_true", help="skip the plots")

@@ -35,6 +35,7 @@ from typing import Any
 from execute.batch.perturb import Draw, PerturbSpec, draw
 from ladders.spec import LadderSpec
 from planner.time_limit import HARD_LIMIT_GRACE_S, TimeLimitExceeded, hard_time_limit
+from robot.constants import DAEMON_RATE_HZ
 
 __all__ = ["DEFAULT_JOB_FUNCTIONS", "HARD_LIMIT_GRACE_S", "JobFunctions", "PlanJob",
            "ValidateJob", "expand_jobs", "plan_job", "validate_job"]
@@ -65,7 +66,7 @@ class PlanJob:
     robot: str = "drc-hubo"
     time_limit_s: float = 600.0
     top_rung: int | None = None
-    rate_hz: float = 200.0
+    rate_hz: float = DAEMON_RATE_HZ
     sweep: tuple[tuple[str, Any], ...] = ()
 
     kind = "plan"
@@ -132,7 +133,7 @@ class ValidateJob:
 def expand_jobs(ladders: Sequence[tuple[str, LadderSpec, dict[str, Any]]], seeds: Sequence[int],
                 strategies: Sequence[str], perturb: PerturbSpec, draws: int = 1, *,
                 robot: str = "drc-hubo", time_limit_s: float = 600.0,
-                top_rung: int | None = None, rate_hz: float = 200.0
+                top_rung: int | None = None, rate_hz: float = DAEMON_RATE_HZ
                 ) -> tuple[list[PlanJob], list[ValidateJob]]:
     """Every job of a batch.
 

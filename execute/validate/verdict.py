@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 import mujoco
 import numpy as np
 
+from robot.constants import GRAVITY_M_S2
 from robot.plan_sidecar import HoldRecord, PlanSidecar
 
 __all__ = ["Failure", "Verdict", "VerdictConfig", "VerdictMonitor", "default_config"]
@@ -102,7 +103,8 @@ class VerdictMonitor:
         m = board.model
         self.model, self.data = m, board.data
         self.pelvis = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "pelvis")
-        self.weight_n = float(sum(m.body_mass[board.model.body_rootid == self.pelvis])) * 9.81
+        mass_kg = float(sum(m.body_mass[board.model.body_rootid == self.pelvis]))
+        self.weight_n = mass_kg * GRAVITY_M_S2
         ladder = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "ladder")
         self.env_geoms = {g for g in range(m.ngeom)
                           if m.geom_bodyid[g] in (0, ladder)}

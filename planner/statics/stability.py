@@ -34,6 +34,7 @@ import numpy as np
 from scipy.optimize import linprog
 
 from planner.contacts import LIMB_FRAME, Stance
+from robot.constants import GRAVITY_M_S2
 from robot.errors import HuboLadderError
 
 log = logging.getLogger(__name__)
@@ -294,7 +295,7 @@ class _ProjectionLP:
         return res.x[self.n_lam:] + self.center
 
 
-def support_region(stance: Stance, mass_kg: float, g: float = 9.81, *,
+def support_region(stance: Stance, mass_kg: float, g: float = GRAVITY_M_S2, *,
                    config: StabilityConfig | None = None) -> SupportRegion:
     """CoM support region of a stance (Bretl & Lall 2008, iterative projection).
 
