@@ -1,14 +1,15 @@
 """``hubo-console``: hubo-ach's console, one command per line on stdin.
 
-    hubo-console [--instance NAME] [-c "CMD; CMD; ..."]
+    hubo-console [--instance NAME] [--robot R] [-c "CMD; CMD; ..."]
 
 Commands (joint ``J`` by name, ``RSP``, or by 0-based index; names are case-insensitive):
 
 ==================  ===========================================================
 ``homeAll``         home every joint (references ignored for 3 s)
 ``home J``          home one joint
-``goto J RAD``      position mode, reference RAD [rad] (filtered), others unchanged
-``comp J RAD``      compliant (PWM) around RAD [rad]
+``goto J RAD``      position mode, reference RAD [rad] (filtered), others unchanged;
+                    RAD within the joint's limits
+``comp J RAD``      compliant (PWM) around RAD [rad], within the joint's limits
 ``kp J V``          PWM proportional gain [%/rad], ``0 <= V < 70``
 ``kd J V``          PWM damping gain [%/(rad/s)], ``0 <= V < 10``
 ``maxPWM J V``      PWM duty clamp [%], ``0 <= V < 8``
@@ -19,9 +20,12 @@ Commands (joint ``J`` by name, ``RSP``, or by 0-based index; names are case-inse
 ``quit``            leave
 ==================  ===========================================================
 
-Gains outside the thesis manual's safety limits are refused here with their range, and
-nothing is sent (the daemon refuses them too). Each command waits until the daemon has
-ticked past it, so consecutive commands are never lost on the latest-value channel.
+Gains outside the thesis manual's safety limits, and ``goto``/``comp`` positions outside
+the joint's limits (`robot.limits`, of ``--robot``), are refused here with the joint, the
+value and the allowed range, and nothing is sent. The daemon refuses them too: it keeps
+the gains, and holds a joint's previous reference when a new one is beyond its limits.
+Each command waits until the daemon has ticked past it, so consecutive commands are never
+lost on the latest-value channel.
 
 Exit codes: 0 every command done, 1 the daemon did not answer, 2 a command was refused
 (unknown command or joint, a value out of range).
@@ -71,10 +75,13 @@ def format_joint(s: np.ndarray, j: int) -> str:
 class Console:
     """The console's commands on one daemon instance (see the module docstring)."""
 
-    def __init__(self, instance: str = "default", out=sys.stdout, err=sys.stderr):
+    def __init__(self, instance: str = "default", out=sys.stdout, err=sys.stderr,
+                 robot: str = "drc-hubo"):
         from daemon.channels import open_channel
+        from robot.limits import joint_limits
 
         self.instance = instance
+        self.limits = joint_limits(robot)
         self.out, self.err = out, err
         self.cmd = open_channel("board-cmd", instance)
         self.ref = open_channel("ref", instance)
@@ -163,8 +170,17 @@ class Console:
             j = _joint(rest[0])
             self.board_command(T.HOME, j)
         elif cmd in ("goto", "comp"):
+            from robot.joints import JOINT_NAMES
+            from robot.limits import LIMIT_TOLERANCE_RAD
+
             j = _joint(rest[0])
-            self.reference(j, parse_finite(rest[1], "position"), cmd == "comp")
+            rad = parse_finite(rest[1], f"{words[0]} {JOINT_NAMES[j]}: position")
+            lo, hi = float(self.limits.lower_rad[j]), float(self.limits.upper_rad[j])
+            if not lo - LIMIT_TOLERANCE_RAD <= rad <= hi + LIMIT_TOLERANCE_RAD:
+                raise InputError(f"{words[0]} {JOINT_NAMES[j]} {rad:g} refused: "
+                                 f"{JOINT_NAMES[j]} is allowed [{lo:.4g}, {hi:.4g}] rad on "
+                                 f"{self.limits.robot}; nothing sent")
+            self.reference(j, min(max(rad, lo), hi), cmd == "comp")
         elif cmd in _GAIN_COMMANDS:
             from robot.joints import JOINT_NAMES
 
@@ -183,6 +199,7 @@ class Console:
         elif cmd == "statusall":
             s = self._state()
             print(f"tick {int(s['tick'])}  overruns {int(s['overruns'])}  "
+                  f"refs rejected {int(s['refs_rejected'])}  "
                   f"t {float(s['time_s']):.2f} s", file=self.out)
             for j in range(len(s["ref"])):
                 print(format_joint(s, j), file=self.out)
@@ -197,11 +214,13 @@ def main(argv: list[str] | None = None) -> int:
     """Entry point of ``hubo-console``; returns the exit code."""
     p = argparse.ArgumentParser(prog="hubo-console", description=__doc__.split("\n\n")[0])
     p.add_argument("--instance", default="default", help="daemon instance (default)")
+    p.add_argument("--robot", default="drc-hubo", choices=("drc-hubo", "hubo2plus"),
+                   help="robot whose joint limits goto and comp respect (default drc-hubo)")
     p.add_argument("-c", dest="commands", metavar="CMDS",
                    help="run these ';'-separated commands instead of reading stdin")
     args = p.parse_args(argv)
     lines = args.commands.split(";") if args.commands is not None else None
-    console = Console(args.instance)
+    console = Console(args.instance, robot=args.robot)
     code = 0
     tty = lines is None and sys.stdin.isatty()
     try:

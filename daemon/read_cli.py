@@ -35,7 +35,8 @@ def state_table(s: np.ndarray, joints: list[int]):
     ft = "  ".join(f"{n} {s['ft'][k]['fz']:+.0f} N" for k, n in enumerate(FT_NAMES))
     imu = s["imu"][0]
     title = (f"tick {int(s['tick'])}  t {float(s['time_s']):.2f} s  overruns "
-             f"{int(s['overruns'])}  power {float(s['power']['V']):.1f} V "
+             f"{int(s['overruns'])}  refs rejected {int(s['refs_rejected'])}  "
+             f"power {float(s['power']['V']):.1f} V "
              f"{float(s['power']['I']):.1f} A\n{ft}  {IMU_NAMES[0]} a "
              f"({imu['ax']:+.2f}, {imu['ay']:+.2f}, {imu['az']:+.2f}) m/s²")
     t = Table(title=title, title_justify="left")

@@ -24,7 +24,7 @@ Sizes (bytes, checked by the tests):
 | ``ref-neck`` | `REF_DTYPE` (only the neck entries are used) | 741 |
 | ``board-cmd`` | `BOARD_CMD_DTYPE` | 76 |
 | ``pwm-gains`` | `PWM_GAINS_DTYPE` | 1300 |
-| ``state`` | `STATE_DTYPE` | 2188 |
+| ``state`` | `STATE_DTYPE` | 2192 |
 """
 
 from __future__ import annotations
@@ -85,6 +85,7 @@ class StatusFlag(enum.IntFlag):
     TEMPERATURE = 1 << 9
     LIMIT_SWITCH = 1 << 10
     COMPLIANT = 1 << 11  #: the joint is in PWM mode
+    REF_REJECTED = 1 << 12  #: its commanded reference is beyond its limits: previous one held
 
 
 HEADER_FIELDS: list[tuple] = [
@@ -140,7 +141,7 @@ IMU_DTYPE = np.dtype(
 )
 POWER_DTYPE = np.dtype([("V", "<f8"), ("I", "<f8"), ("P", "<f8")], align=False)  # [V, A, W]
 
-#: ``state``: what the daemon measured. 2188 bytes.
+#: ``state``: what the daemon measured. 2192 bytes.
 STATE_DTYPE = np.dtype(
     HEADER_FIELDS
     + [
@@ -159,6 +160,7 @@ STATE_DTYPE = np.dtype(
         ("ft", FT_DTYPE, (NUM_FT,)),
         ("imu", IMU_DTYPE, (NUM_IMU,)),
         ("power", POWER_DTYPE),
+        ("refs_rejected", "<u4"),  # ref samples with a joint beyond its limits, since start
     ],
     align=False,
 )
