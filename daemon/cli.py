@@ -62,7 +62,8 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def status_line(loop) -> str:
-    """One line: ticks, overruns, watchdog, homing, compliance, replies, power."""
+    """One line: ticks, overruns, watchdog, homing, compliance, replies, board commands,
+    ref samples rejected beyond the joint limits, power."""
     from daemon.structs import StatusFlag
 
     s = loop.state
@@ -75,6 +76,7 @@ def status_line(loop) -> str:
             f"late max {st.max_late_ns / 1e6:.2f} ms  watchdog {'HOLD' if loop.holding else 'ok'}"
             f"  gated {gated}  pwm {int(np.sum(s['comply']))}  no-reply {silent}  "
             f"tripped {tripped}  cmds {st.cmds_done}/{st.cmds_refused} refused  "
+            f"refs rejected {st.refs_rejected}  "
             f"{float(s['power']['V']):.1f} V")
 
 

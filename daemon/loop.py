@@ -30,6 +30,13 @@ Holds. A joint keeps its last sent reference (mode DIRECT with ``r = f``, exactl
   from before start-up are ignored, so a stale reference never moves the robot);
 - *a malformed sample* (non-finite reference, mode outside 0..3): refused and logged.
 
+Limits. A joint whose commanded reference lies beyond its limits keeps its previous
+accepted reference (the control law rejects it, `JointController`); the other joints of
+the sample are followed. This holds for every writer (player, console, a script on the
+channel). Each such sample is logged once with the joints, values and allowed ranges,
+and counted in ``state["refs_rejected"]``; the joints carry ``REF_REJECTED`` in their
+status while the sample stands.
+
 Gates. A joint's references are ignored (it holds its gate reference, rigid) while it is
 not homed, for ``home_ignore_s`` after a home command (3 s), for ``startup_ignore_s``
 after start-up (0.8 s, hubo-facts §3) and while its control is off (then its board
@@ -251,6 +258,7 @@ class LoopStats:
     watchdog_trips: int = 0
     cmds_done: int = 0
     cmds_refused: int = 0
+    refs_rejected: int = 0  # ref samples with a joint beyond its limits
     gains_version: int = 0
     max_late_ns: int = 0
     starts_ns: list[int] = field(default_factory=list)  # with record_starts
@@ -319,6 +327,8 @@ class DaemonLoop:
         self._last_comply = np.zeros(NUM_JOINTS, bool)
         self._watchdog = False
         self._bad_ref_ns = 0
+        self._ref_key: tuple[int, int, int] | None = None  # the ref sample used this tick
+        self._rejected_key: tuple[int, int, int] | None = None
         self._rec = np.zeros((), LOG_DTYPE)
         # the state struct is the first STATE_DTYPE.itemsize bytes of the log record
         self._state = np.ndarray((), STATE_DTYPE, buffer=self._rec.data)
@@ -438,6 +448,8 @@ class DaemonLoop:
                 feedforward = np.where(gated, 0.0, feedforward)
         out = self.controller.tick(ref, mode, comply, sensors.pos_rad, sensors.vel_rad_s,
                                    self.gains, feedforward)
+        if out.limit_rejected.any():
+            self._count_rejection(ref, out.limit_rejected)
         self.backend.write_commands(BoardCommands.from_output(out, self.control_off))
         self._publish(start_ns, late_ns, now_s, sensors, out, ref, mode, comply, gated,
                       watchdog, playing, age_s)
@@ -466,7 +478,9 @@ class DaemonLoop:
         status = status | np.where(gated & ~self.control_off, int(StatusFlag.NOT_HOMED), 0)
         status = status | np.where(out.pwm, int(StatusFlag.COMPLIANT), 0)
         status = status | np.where(out.duty_saturated, int(StatusFlag.PWM_SATURATED), 0)
+        status = status | np.where(out.limit_rejected, int(StatusFlag.REF_REJECTED), 0)
         s["status"] = status
+        s["refs_rejected"] = st.refs_rejected
         ft = s["ft"]
         ft["mx"], ft["my"], ft["fz"] = sensors.ft[:, 0], sensors.ft[:, 1], sensors.ft[:, 2]
         imu = s["imu"]
@@ -499,8 +513,10 @@ class DaemonLoop:
         ``ref`` is None when there is no usable sample (none since start-up, or refused).
         """
         s = self.channels.ref.read_latest()
+        self._ref_key = None
         if s is None or int(s["time_ns"]) < self._t0_ns:
             return None, None, None, None, False, float("inf")
+        self._ref_key = (int(s["time_ns"]), int(s["seq"]), int(s["writer_id"]))
         age_s = (now_ns - int(s["time_ns"])) * 1e-9
         ref = np.array(s["ref"], dtype=float)
         mode = np.array(s["mode"], dtype=np.int8)
@@ -531,6 +547,19 @@ class DaemonLoop:
                           int(s["writer_id"]), problem)
             return None, None, None, None, bool(s["playing"]), age_s
         return ref, mode, comply, feedforward, bool(s["playing"]), age_s
+
+    def _count_rejection(self, ref: np.ndarray, rejected: np.ndarray) -> None:
+        """Count and log a ref sample with joints beyond their limits, once per sample."""
+        key = self._ref_key
+        if key is None or key == self._rejected_key:
+            return
+        self._rejected_key = key
+        self.stats.refs_rejected += 1
+        lim = self.controller.limits
+        what = ", ".join(f"{JOINT_NAMES[j]} {ref[j]:.4g} rad (allowed [{lim.lower_rad[j]:.4g}, "
+                         f"{lim.upper_rad[j]:.4g}])" for j in np.flatnonzero(rejected))
+        log.error("ref sample from writer %d rejected beyond the joint limits: %s; those "
+                  "joints hold their previous reference", key[2], what)
 
     def _poll_commands(self, now_s: float) -> None:
         c = self.channels.board_cmd.read_latest()

@@ -306,3 +306,30 @@ def test_the_players_feed_forward_adds_to_compliant_joints_only_and_is_bounded()
     w.ref.write(s)
     loop.run(max_ticks=10)
     assert be.sent[-1].duty_pct[LSP] == 0.0 and not be.sent[-1].pwm[LSP]
+
+
+def test_a_reference_beyond_a_limit_from_any_writer_is_rejected_and_counted(caplog):
+    be = FakeBackend()
+    loop, w = _loop(be)
+    RKN, REB = JOINT_INDEX["RKN"], JOINT_INDEX["REB"]
+    w.ref.write(_ref(playing=0, RKN=1.0, RSP=-0.2))
+    loop.run(max_ticks=200)
+    assert be.sent[-1].ref_rad[RKN] == pytest.approx(1.0, abs=0.01)
+    with caplog.at_level("ERROR", logger="daemon.loop"):
+        w.ref.write(_ref(playing=0, RKN=3.0, REB=0.5, RSP=-0.4))  # RKN ≤ 2.61, REB ≤ 0
+        loop.run(max_ticks=400)
+    last = be.sent[-1].ref_rad
+    assert last[RKN] == pytest.approx(1.0, abs=0.01)  # held where it was, not 2.61
+    assert last[REB] == pytest.approx(0.0)
+    assert last[RSP] == pytest.approx(-0.4, abs=0.01)  # the rest of the sample is followed
+    assert loop.stats.refs_rejected == 1  # one sample, counted once however long it stands
+    s = loop.state
+    assert int(s["refs_rejected"]) == 1
+    flagged = np.flatnonzero(np.asarray(s["status"]) & int(StatusFlag.REF_REJECTED))
+    assert sorted(flagged.tolist()) == sorted([RKN, REB])
+    msg = caplog.text
+    assert "writer 99" in msg and "RKN 3 rad (allowed [0, 2.61])" in msg and "REB 0.5 rad" in msg
+    w.ref.write(_ref(playing=0, RKN=1.5))  # a good sample clears the flags; the count stays
+    loop.run(max_ticks=500)
+    assert not (np.asarray(loop.state["status"]) & int(StatusFlag.REF_REJECTED)).any()
+    assert int(loop.state["refs_rejected"]) == 1
