@@ -2,14 +2,23 @@
 
     play-trajectory -n FILE [-f 10|25|50|100|200|500] [-i] [-c|-cl|-cr] [-nf] [-p]
                     [-line N] [--no-auto-modes] [--instance NAME] [--robot R]
+                    [--clamp-limits TOL]
 
 Before anything is sent, the whole file is checked (`robot.trajectory_file`): a bad file
-exits 2 naming ``FILE:LINE:COLUMN``, and the ``ref`` channel is never written. The
-sidecar ``FILE.plan.json``, when present, gives the rate (unless ``-f``), the per-arm
+exits 2 naming ``FILE:LINE:COLUMN``, and the ``ref`` channel is never written. Values
+beyond a joint limit are refused too, unless ``--clamp-limits TOL`` [rad] is given: then
+values at most TOL beyond a limit are moved onto it (files written for the original player
+overshoot the knee's 0 lower limit by up to 0.07 rad), and a per-joint report says which
+lines moved and the largest overshoot; farther values are still refused. The sidecar
+``FILE.plan.json``, when present, gives the rate (unless ``-f``), the per-arm
 position/PWM schedule and the compliant arms' feed-forward (unless ``--no-auto-modes``);
 ``-c``, ``-cl``, ``-cr`` force an arm compliant for the whole file. The feed-forward
 torques go out as each ``ref`` sample's ``pwm_command`` duty, at the battery voltage the
 daemon reports (as ``validate-plan`` plays them).
+
+One player at a time: before touching a channel it takes the instance's player lock
+(`execute.play.lock`); a second player on the same daemon exits 2 naming the first one's
+pid. A lock left by a killed player is recovered.
 
 Then it waits for a running ``hubo-daemon`` on ``--instance`` (its ``state`` channel
 ticking), refuses joints that are not homed, waits for a homing in progress to end, and
@@ -24,7 +33,8 @@ At the end, and on Ctrl-C / SIGTERM, the last reference stays on the channel wit
 ``playing`` cleared: the robot holds it.
 
 Exit codes: 0 played to the end, 1 refused or failed (no daemon, not homed, too far from
-the start line), 2 bad input, 130 stopped by Ctrl-C (holding).
+the start line), 2 bad input or another player on the instance, 130 stopped by Ctrl-C
+(holding).
 """
 
 from __future__ import annotations
@@ -82,6 +92,10 @@ def _parser() -> argparse.ArgumentParser:
                    help="duration of the -i move [s] (default 3)")
     p.add_argument("--line-tolerance", type=float, default=0.05, metavar="RAD",
                    help="without -i: largest joint distance to the start line [rad]")
+    p.add_argument("--clamp-limits", type=float, default=None, metavar="TOL",
+                   help="clamp values at most TOL [rad] (up to 0.1) beyond a joint limit onto "
+                        "it, with a per-joint report; farther ones are refused (default: "
+                        "strict, every value within the limits)")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress line")
     return p
 
@@ -94,7 +108,7 @@ def _load(args):
         compliant_arms_from_flags,
     )
     from robot.plan_sidecar import read_sidecar, sidecar_path
-    from robot.trajectory_file import read_trajectory
+    from robot.trajectory_file import format_clamps, read_trajectory, read_trajectory_clamped
 
     path = Path(args.file)
     side = sidecar_path(path)
@@ -104,7 +118,14 @@ def _load(args):
         log.warning("%s was timed for %g Hz; playing it at %d Hz changes its speed", path,
                     sidecar.rate_hz, args.rate)
     robot = args.robot or (sidecar.robot if sidecar else "drc-hubo")
-    traj = read_trajectory(path, rate, robot)
+    args.robot = robot
+    if args.clamp_limits is None:
+        traj = read_trajectory(path, rate, robot)
+    else:
+        traj, clamps = read_trajectory_clamped(path, rate, args.clamp_limits, robot)
+        if clamps:
+            print(f"play-trajectory: {format_clamps(str(path), clamps, args.clamp_limits)}",
+                  file=sys.stderr, flush=True)
     if sidecar and len(traj) != sidecar.line_count:
         raise InputError(f"{path}:{len(traj)}: the file has {len(traj)} lines, its sidecar "
                          f"{side} says {sidecar.line_count}")
@@ -187,7 +208,10 @@ def _play(args, traj, player, auto) -> int:
     from daemon.channels import open_channel
     from daemon.loop import sleep_until_ns
     from daemon.structs import REF_DTYPE, new_sample
+    from robot.limits import joint_limits
     from robot.motors import DEFAULT_BATTERY_V, motor_table
+
+    limits = joint_limits(args.robot)
 
     ref = open_channel("ref", args.instance)
     state = open_channel("state", args.instance)
@@ -233,7 +257,10 @@ def _play(args, traj, player, auto) -> int:
             # battery voltage.
             latest = state.read_latest() if not player.started or player.has_feedforward \
                 else None
-            pos = np.asarray(latest["pos"]) if not player.started else None
+            # go-to-init starts from the measured pose, within the limits (the daemon
+            # rejects a reference beyond them; an encoder may read a hair past one)
+            pos = np.clip(latest["pos"], limits.lower_rad, limits.upper_rad) \
+                if not player.started else None
             if player.started:
                 while flags["toggles"]:
                     flags["toggles"] -= 1
@@ -284,8 +311,11 @@ def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     logging.basicConfig(level=logging.WARNING, format="%(name)s: %(message)s")
     def job() -> int:
+        from execute.play.lock import PlayerLock
+
         traj, player, auto = _load(args)
-        return _play(args, traj, player, auto)
+        with PlayerLock(args.instance):  # one player per daemon; before any channel
+            return _play(args, traj, player, auto)
 
     try:
         return run_cli("play-trajectory", job)
