@@ -13,6 +13,8 @@ from pathlib import Path
 
 import numpy as np
 
+from robot.errors import HuboLadderError
+
 __all__ = ["FOLLOW_DISTANCE_M", "FOLLOW_ELEVATION_DEG", "SNAPSHOT_SIZE",
            "RenderingUnavailable", "render_states", "write_strip"]
 
@@ -24,8 +26,9 @@ FOLLOW_DISTANCE_M = 2.8
 FOLLOW_ELEVATION_DEG = -10.0
 
 
-class RenderingUnavailable(RuntimeError):
-    """No off-screen OpenGL context could be created (EGL missing)."""
+class RenderingUnavailable(HuboLadderError, RuntimeError):
+    """No off-screen OpenGL context could be created (EGL missing). Also a `RuntimeError`,
+    as it was before it joined the project's error root."""
 
 
 def render_states(model, qpos: np.ndarray, size: tuple[int, int]) -> list[np.ndarray]:

@@ -38,6 +38,7 @@ from primitives.primitive import Step
 from robot.errors import HuboLadderError, InputError
 from robot.joints import ARM_JOINTS, FINGER_JOINTS, LEG_JOINTS
 from robot.kinematic_tree import FINGER_CLOSED_RAD
+from robot.vocabulary import InterpolationFailure, Limb, RejectCause, StepFailure
 
 log = logging.getLogger(__name__)
 
@@ -200,10 +201,6 @@ def closed_hand_wrist_pitch_range_rad(kin: HuboKinematics, collision: CollisionM
     return out[0], out[1]
 
 
-def _limb_side(limb: str) -> str:
-    return "left" if limb.startswith("left") else "right"
-
-
 class ClimbPlanner:
     """Plans a climb of one ladder for one robot."""
 
@@ -252,10 +249,10 @@ class ClimbPlanner:
         for posture in START_POSTURES:
             q, stance = self._standing(posture)
             verdict = self.checker.check(q, stance, self._contacts(stance.holds))
-            if verdict.ok or not verdict.reason.startswith("collision"):
+            if verdict.ok or verdict.cause is not RejectCause.COLLISION:
                 self._standing_pelvis_z_m = float(q[2])
                 return q, stance
-            hits.append(verdict.reason.removeprefix("collision "))
+            hits.append("–".join(verdict.colliding[0]) if verdict.colliding else "collision")
         raise InputError(
             f"ladder '{self.spec.name}': placement_x_m = {self.spec.placement_x_m:g} m "
             f"leaves the robot no room to stand in front of it (every start posture touches "
@@ -354,7 +351,7 @@ class ClimbPlanner:
         posture = dict(step.primitive.posture_rad)
         for h in support:
             if h.is_hand:
-                for name in ARM_JOINTS[_limb_side(h.limb)]:
+                for name in ARM_JOINTS[Limb(h.limb).side]:
                     if name in self.kin.q_index:
                         posture[name] = float(q[self.kin.q_index[name]])
         return posture
@@ -402,7 +399,8 @@ class ClimbPlanner:
         cfg = self.config
         if (attempt < cfg.limb_rrt_after_failures
                 or stats.limb_detour_tries >= cfg.limb_rrt_tries_per_step
-                or not exc.reason.startswith("midpoint infeasible: collision")):
+                or exc.cause is not InterpolationFailure.MIDPOINT_INFEASIBLE
+                or exc.verdict_cause is not RejectCause.COLLISION):
             raise exc
         stats.limb_detour_tries += 1
         joints = [(names, [self.kin.q_index[n] for n in names])
@@ -430,8 +428,8 @@ class ClimbPlanner:
         return path
 
     def _limb_joints(self, limb: str) -> list[str]:
-        table = ARM_JOINTS if limb.endswith("hand") else LEG_JOINTS
-        return [n for n in table[_limb_side(limb)] if n in self.kin.q_index]
+        table = ARM_JOINTS if Limb(limb).is_hand else LEG_JOINTS
+        return [n for n in table[Limb(limb).side] if n in self.kin.q_index]
 
     # ----------------------------------------------------------------------------------
     def try_step(self, step: Step, q: np.ndarray, stance: Stance, radius_m: float,
@@ -455,7 +453,8 @@ class ClimbPlanner:
             q_new, verdict = find_feasible(self.kin, self.checker, q, target, self.rng,
                                            attempts=self.config.feasible_attempts, stats=fstats)
             if q_new is None:
-                raise _StepRejected(f"no straightened pose: {_why(verdict)}")
+                raise _StepRejected(StepFailure.NO_STRAIGHT_POSE,
+                                   f"no straightened pose: {_why(verdict)}")
             path = self._interp(q, q_new, stance.holds, stance, self._contacts(stance.holds),
                                 stats)
             segments.append(PathSegment(step, "body", stance.holds, (), path))
@@ -474,7 +473,7 @@ class ClimbPlanner:
                                             attempts=self.config.feasible_attempts,
                                             stats=fstats, q_hint=self._hint(step, 0, attempt))
             if q_lift is None:
-                raise _StepRejected(f"no lift-off pose: {_why(verdict)}")
+                raise _StepRejected(StepFailure.NO_LIFT_OFF, f"no lift-off pose: {_why(verdict)}")
             self._remember(step, 0, q_lift)
             path = self._interp(q, q_lift, stance.holds, stance, contacts_all, stats)
             segments.append(PathSegment(step, "body", stance.holds, (), path))
@@ -483,8 +482,8 @@ class ClimbPlanner:
         q_cur = q_lift
         for limb in moving_limbs:
             old = stance.hold(limb)
-            if limb.endswith("hand") and old is not None:
-                path = self._finger_path(q_cur, _limb_side(limb), 0.0)
+            if Limb(limb).is_hand and old is not None:
+                path = self._finger_path(q_cur, Limb(limb).side, 0.0)
                 segments.append(PathSegment(step, "release", support, moving_limbs, path))
                 q_cur = path[-1]
 
@@ -522,7 +521,8 @@ class ClimbPlanner:
                 ik_config=self.ik_config if final else self.ik_waypoint_config,
                 q_hint=self._hint(step, i, attempt))
             if q_next is None:
-                raise _StepRejected(f"way-point {i}/{n_way - 1}: {_why(verdict)}")
+                raise _StepRejected(StepFailure.WAYPOINT,
+                                   f"way-point {i}/{n_way - 1}: {_why(verdict)}")
             self._remember(step, i, q_next)
             try:
                 limb_path += self._interp(q_cur, q_next, support, support_stance, contacts,
@@ -540,23 +540,26 @@ class ClimbPlanner:
         polished = solve_ik(self.kin, q_cur, next_stance.holds, config=self.ik_config,
                             posture_rad=self.kin.posture(q_cur), preferences=False)
         if not polished.converged:
-            raise _StepRejected(f"placed pose does not meet its holds: {polished!r}")
+            raise _StepRejected(StepFailure.HOLDS_NOT_MET,
+                               f"placed pose does not meet its holds: {polished!r}")
         correction = self.kin.joint_distance(polished.q, q_cur)
         if correction > POLISH_MAX_RAD:
-            raise _StepRejected(f"placing the holds exactly moves a joint {correction:.3f} rad")
+            raise _StepRejected(StepFailure.POLISH_TOO_FAR,
+                               f"placing the holds exactly moves a joint {correction:.3f} rad")
         n = int(np.ceil(correction / self.config.resolution_rad))
         limb_path += [self.kin.interpolate(q_cur, polished.q, (k + 1) / n) for k in range(n)]
         q_cur = polished.q
         verdict = self.checker.check(q_cur, next_stance, self._contacts(next_stance.holds))
         if not verdict.ok:
-            raise _StepRejected(f"placed pose unstable in the new stance: {verdict.reason}")
+            raise _StepRejected(StepFailure.UNSTABLE_PLACED,
+                               f"placed pose unstable in the new stance: {verdict.reason}")
 
         # 5. Close the hands that arrived on a rail. A closing hand is not a hold yet: it
         # joins the holds in contact once its fingers are closed.
         in_contact = list(support) + [h for h in new_holds if not h.is_hand]
         for hold in new_holds:
             if hold.is_hand:
-                path = self._finger_path(q_cur, _limb_side(hold.limb), FINGER_CLOSED_RAD)
+                path = self._finger_path(q_cur, Limb(hold.limb).side, FINGER_CLOSED_RAD)
                 segments.append(PathSegment(step, "grasp", tuple(in_contact), (hold.limb,),
                                             path))
                 in_contact.append(hold)
@@ -598,7 +601,7 @@ class ClimbPlanner:
             except (_StepRejected, InterpolationError) as exc:
                 failures[i] += 1
                 stats[i].seconds += time.perf_counter() - t0
-                key = str(exc).split(":")[0][:40]
+                key = exc.cause.value
                 stats[i].failures[key] = stats[i].failures.get(key, 0) + 1
                 log.debug("%s sample %d failed: %s", step.label, failures[i], exc)
                 if failures[i] >= self.config.samples_per_step:
@@ -628,5 +631,13 @@ def _why(verdict) -> str:
     return verdict.reason if verdict is not None else "no candidate converged"
 
 
-class _StepRejected(Exception):
-    """One sample of a step failed (the search tries another)."""
+class _StepRejected(HuboLadderError):
+    """One sample of a step failed (the search tries another).
+
+    Attributes:
+        cause: what failed; its value is the key of the step's ``failures`` count.
+    """
+
+    def __init__(self, cause: StepFailure, message: str):
+        super().__init__(message)
+        self.cause = cause

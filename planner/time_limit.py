@@ -12,12 +12,22 @@ import contextlib
 import signal
 import threading
 
+from robot.errors import HuboLadderError
+
 #: Planning is stopped this long after its time limit when the search overruns it [s].
 HARD_LIMIT_GRACE_S = 0.5
 
 
-class TimeLimitExceeded(Exception):
-    """Raised by the alarm signal when the planning time is over."""
+class TimeLimitExceeded(HuboLadderError):
+    """Raised by the alarm signal when the planning time is over.
+
+    Attributes:
+        limit_s: the wall-clock limit that ran out (the planning limit plus the grace) [s].
+    """
+
+    def __init__(self, limit_s: float):
+        super().__init__(f"planning stopped after its hard time limit of {limit_s:g} s")
+        self.limit_s = limit_s
 
 
 @contextlib.contextmanager
@@ -29,7 +39,7 @@ def hard_time_limit(seconds: float):
         return
 
     def on_alarm(signum, frame):
-        raise TimeLimitExceeded
+        raise TimeLimitExceeded(seconds)
 
     previous = signal.signal(signal.SIGALRM, on_alarm)
     signal.setitimer(signal.ITIMER_REAL, seconds)

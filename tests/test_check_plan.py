@@ -146,3 +146,33 @@ def test_a_lone_compliant_hand_is_not_counted_on_for_balance():
     np.testing.assert_allclose(region["mixed"].vertices, feet_region.vertices)
     behind = np.array([feet_region.vertices[:, 0].min() - 0.03, 0.0])
     assert region["mixed"].margin(behind) < 0 < region["position"].margin(behind)
+
+
+def test_failing_lines_are_counted_once(good, tmp_path, capsys):
+    """One line past a limit is "1 line"; the spike makes two bad steps: "2 lines"."""
+    bad = _copy(good, tmp_path / "spike.traj")
+    lines = bad.read_text().splitlines()
+    cols = lines[99].split()
+    k = JOINT_INDEX["RKN"]
+    cols[k] = repr(float(joint_limits().upper_rad[k]) + 0.2)
+    lines[99] = " ".join(cols)
+    bad.write_text("\n".join(lines) + "\n")
+    assert main([str(bad), "--every", "50"]) == 1
+    out = capsys.readouterr().out
+    rows = {r.split("│")[1].strip(): r for r in out.splitlines() if r.count("│") > 2}
+    assert "FAIL (1 line)" in rows["joint limits"]
+    assert "FAIL (2 lines)" in rows["velocity"]
+
+
+def test_user_text_is_printed_verbatim(good, tmp_path, capsys):
+    """Rich would print `:100:` as an emoji and eat `[...]`: every message keeps them."""
+    odd = _copy(good, tmp_path / "run:100:[red]x[bold].traj")
+    assert main([str(odd), "--ladder", "drc", "--every", "50"]) == 0
+    out = capsys.readouterr().out
+    assert f"check-plan {odd} (" in out.replace("\n", "")  # the title, unwrapped by width
+    lines = odd.read_text().splitlines()
+    lines[99] = lines[99].replace(" ", " x", 1)  # a bad token on line 100
+    odd.write_text("\n".join(lines) + "\n")
+    assert main([str(odd), "--ladder", "drc"]) == 2
+    err = capsys.readouterr().err
+    assert f"{odd}:100:" in err and "💯" not in err

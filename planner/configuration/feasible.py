@@ -21,6 +21,7 @@ from planner.configuration.ik import FIXED_JOINT_PREFIXES, IKConfig, solve_ik
 from planner.configuration.kinematics import HuboKinematics
 from planner.configuration.validity import FeasibilityChecker, Verdict
 from planner.contacts import Hold, Stance
+from robot.vocabulary import RejectCause
 
 log = logging.getLogger(__name__)
 
@@ -57,10 +58,9 @@ class FeasibleSearchStats:
     ik_failures: int = 0
     rejections: dict[str, int] | None = None
 
-    def reject(self, reason: str) -> None:
+    def reject(self, cause: RejectCause) -> None:
         self.rejections = self.rejections or {}
-        key = reason.split(" ")[0]
-        self.rejections[key] = self.rejections.get(key, 0) + 1
+        self.rejections[cause.value] = self.rejections.get(cause.value, 0) + 1
 
 
 #: Torque descent: evaluations per attempt; it gives up after ``PATIENCE`` candidates in
@@ -187,14 +187,14 @@ def find_feasible(kin: HuboKinematics, checker: FeasibilityChecker, q_seed: np.n
                               config=ik_config)
             if not result.converged:
                 stats.ik_failures += 1
-                last = Verdict(False, f"ik {result!r}", np.nan, np.nan)
+                last = Verdict(False, f"ik {result!r}", np.nan, np.nan, cause=RejectCause.IK)
                 break
             verdict = checker.check(result.q, target.stability_stance, target.contacts)
             if verdict.ok:
                 return result.q, verdict
             last = verdict
-            stats.reject(verdict.reason)
-            if verdict.reason.startswith("torque") and np.isfinite(verdict.torque_ratio):
+            stats.reject(verdict.cause)
+            if verdict.cause is RejectCause.TORQUE and np.isfinite(verdict.torque_ratio):
                 q_ok, v = _descend_torque(kin, checker, target, rng, result.q,
                                           verdict.torque_ratio, polygon,
                                           ik_config, stats)

@@ -30,6 +30,7 @@ from planner.statics.stability import (
     torque_feasibility,
     torque_limits_by_joint,
 )
+from robot.vocabulary import RejectCause
 
 #: Tolerance on the joint limits [rad] (placo's QP meets them to solver precision).
 LIMIT_TOL_RAD = 1e-6
@@ -45,6 +46,8 @@ class Verdict:
     torque_ratio: float
     clearance_m: float = float("nan")
     environment_only: bool = False  # the only problem is a collision with the ladder/floor
+    cause: RejectCause | None = None  # why it is not feasible (None when it is)
+    colliding: tuple[tuple[str, str], ...] = ()  # the colliding pairs, for a collision
 
     def __bool__(self) -> bool:
         return self.ok
@@ -103,26 +106,32 @@ class FeasibilityChecker:
                 moving limb at the ends of its path the object it leaves or reaches).
         """
         if not self.within_limits(q):
-            return Verdict(False, "joint limits", np.nan, np.nan)
+            return Verdict(False, "joint limits", np.nan, np.nan,
+                           cause=RejectCause.JOINT_LIMITS)
         self.collision.allow(contacts)
         if self.collision.in_collision(q):
             pairs = self.collision.colliding_pairs(q)
             env = set(self.collision.env_names)
             env_only = all(a.split("/")[0] in env or b.split("/")[0] in env for a, b in pairs)
             return Verdict(False, f"collision {pairs[0][0]}–{pairs[0][1]}" if pairs else
-                           "collision", np.nan, np.nan, environment_only=env_only)
+                           "collision", np.nan, np.nan, environment_only=env_only,
+                           cause=RejectCause.COLLISION, colliding=tuple(map(tuple, pairs)))
         region = self.region(stance)
         if region.is_empty:
-            return Verdict(False, "stance cannot balance gravity", -np.inf, np.inf)
+            return Verdict(False, "stance cannot balance gravity", -np.inf, np.inf,
+                           cause=RejectCause.UNBALANCEABLE_STANCE)
         report = check_stability(self.kin.model, self.kin.data, q, stance, region,
                                  self.torque_limits(stance), min_margin_m=self.min_margin_m,
                                  frame_ids=self.frame_ids)
         ratio = report.torque.max_ratio if report.torque is not None else np.inf
         if not report.stable or ratio > self.max_torque_ratio:
-            why = (f"CoM {report.margin_m * 100:.1f} cm outside the support region"
-                   if report.torque is None else
-                   f"torque {ratio:.2f}× limit at {report.torque.worst_joint}")
-            return Verdict(False, why, report.margin_m, ratio)
+            if report.torque is None:
+                cause = RejectCause.COM_OUTSIDE
+                why = f"CoM {report.margin_m * 100:.1f} cm outside the support region"
+            else:
+                cause = RejectCause.TORQUE
+                why = f"torque {ratio:.2f}× limit at {report.torque.worst_joint}"
+            return Verdict(False, why, report.margin_m, ratio, cause=cause)
         return Verdict(True, "ok", report.margin_m, ratio)
 
     def within_limits(self, q: np.ndarray) -> bool:

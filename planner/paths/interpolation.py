@@ -17,6 +17,8 @@ from planner.configuration.ik import IKConfig, solve_ik
 from planner.configuration.kinematics import HuboKinematics
 from planner.configuration.validity import FeasibilityChecker
 from planner.contacts import Hold, Stance
+from robot.errors import HuboLadderError
+from robot.vocabulary import InterpolationFailure, RejectCause
 
 #: The projection's pull towards the joint-space midpoint (keeps it local).
 MIDPOINT_POSTURE_WEIGHT = 0.1
@@ -28,13 +30,23 @@ PROJECTION_TOL_M = 2e-4
 JUMP_RATIO = 0.8
 
 
-class InterpolationError(Exception):
-    """A midpoint could not be projected, or its projection is infeasible."""
+class InterpolationError(HuboLadderError):
+    """A midpoint could not be projected, or its projection is infeasible.
 
-    def __init__(self, reason: str, depth: int):
+    Attributes:
+        cause: what failed.
+        reason: the message, with the figures.
+        depth: recursion depth of the failing midpoint.
+        verdict_cause: for an infeasible midpoint, why the predicate refused it.
+    """
+
+    def __init__(self, cause: InterpolationFailure, reason: str, depth: int,
+                 verdict_cause: RejectCause | None = None):
         super().__init__(f"{reason} (recursion depth {depth})")
+        self.cause = cause
         self.reason = reason
         self.depth = depth
+        self.verdict_cause = verdict_cause
 
 
 @dataclass
@@ -84,10 +96,12 @@ def contact_space_interpolate(kin: HuboKinematics, checker: FeasibilityChecker,
                        com_polygon_cw=com_polygon_cw, preferences=False, config=cfg)
         stats.projections += 1
         if not res.converged:
-            raise InterpolationError(f"projection failed: {res!r}", depth)
+            raise InterpolationError(InterpolationFailure.PROJECTION_FAILED,
+                                     f"projection failed: {res!r}", depth)
         if max(kin.joint_distance(q0, res.q), kin.joint_distance(res.q, q1)) > JUMP_RATIO * span:
             worst = int(np.argmax(np.abs(res.q[7:] - qm[7:])))
             raise InterpolationError(
+                InterpolationFailure.BRANCH_JUMP,
                 f"projection jumped to another IK branch at joint "
                 f"{kin.model.names[worst + 2]} ({qm[7 + worst]:.3f} → {res.q[7 + worst]:.3f} rad)",
                 depth)
@@ -98,7 +112,8 @@ def contact_space_interpolate(kin: HuboKinematics, checker: FeasibilityChecker,
         if span <= resolution_rad:
             return [q1]
         if depth >= max_depth:
-            raise InterpolationError("resolution not reached", depth)
+            raise InterpolationError(InterpolationFailure.RESOLUTION, "resolution not reached",
+                                     depth)
         stats.max_depth = max(stats.max_depth, depth + 1)
         qm = kin.interpolate(q0, q1, 0.5)
         moving_targets = tuple(
@@ -116,7 +131,9 @@ def contact_space_interpolate(kin: HuboKinematics, checker: FeasibilityChecker,
             q_mid, verdict = project(q0, q1, span, qm, moving_targets,
                                      region.clockwise_vertices(), depth)
         if not verdict.ok:
-            raise InterpolationError(f"midpoint infeasible: {verdict.reason}", depth)
+            raise InterpolationError(InterpolationFailure.MIDPOINT_INFEASIBLE,
+                                     f"midpoint infeasible: {verdict.reason}", depth,
+                                     verdict.cause)
         stats.min_margin_m = min(stats.min_margin_m, verdict.com_margin_m)
         stats.max_torque_ratio = max(stats.max_torque_ratio, verdict.torque_ratio)
         return rec(q0, q_mid, depth + 1) + rec(q_mid, q1, depth + 1)

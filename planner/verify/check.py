@@ -361,8 +361,9 @@ def check_plan(traj_rad: np.ndarray, sidecar: PlanSidecar, spec, robot: str | No
 
     # Joint limits and speeds: whole-array checks.
     beyond = np.maximum(lim.lower_rad - traj_rad, traj_rad - lim.upper_rad)
-    for k in np.argsort(-beyond.max(axis=1))[:1].tolist() + \
-            np.flatnonzero(beyond.max(axis=1) > LIMIT_TOL_RAD).tolist():
+    # The worst line, then every failing line, each once (the worst is usually among them).
+    for k in dict.fromkeys(np.argsort(-beyond.max(axis=1))[:1].tolist()
+                           + np.flatnonzero(beyond.max(axis=1) > LIMIT_TOL_RAD).tolist()):
         j = int(np.argmax(beyond[k]))
         res["joint limits"].offer(k + 1, beyond[k, j], float(beyond[k, j]),
                                   f"{JOINT_NAMES[j]} = {traj_rad[k, j]:.4f} rad, limits "
@@ -371,7 +372,8 @@ def check_plan(traj_rad: np.ndarray, sidecar: PlanSidecar, spec, robot: str | No
     if n > 1:
         ratio = np.abs(np.diff(traj_rad, axis=0)) * rate_hz / lim.velocity_nominal_rad_s
         worst = ratio.max(axis=1)
-        for k in [int(np.argmax(worst))] + np.flatnonzero(worst > 1.0 + 1e-9).tolist():
+        for k in dict.fromkeys([int(np.argmax(worst))]
+                               + np.flatnonzero(worst > 1.0 + 1e-9).tolist()):
             j = int(np.argmax(ratio[k]))
             vnom = lim.velocity_nominal_rad_s[j]
             res["velocity"].offer(k + 2, ratio[k, j], float(ratio[k, j]),

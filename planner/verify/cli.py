@@ -59,6 +59,16 @@ def _ladder(args, sidecar: PlanSidecar, where: str):
     return parse_ladder_yaml(yaml.safe_dump(sidecar.ladder), f"{where}: field 'ladder'")
 
 
+def _verdict(r: CheckResult):
+    """``pass`` in green, or ``FAIL (n lines)`` in red (styled text: never parsed as markup)."""
+    from rich.text import Text
+
+    if r.ok:
+        return Text("pass", style="green")
+    n = r.failing_lines
+    return Text.assemble(("FAIL", "red"), f" ({n} line{'' if n == 1 else 's'})")
+
+
 def _table(results: list[CheckResult], title: str):
     from rich.table import Table
 
@@ -66,23 +76,23 @@ def _table(results: list[CheckResult], title: str):
     for col in ("check", "result", "worst line", "value", "limit", "where"):
         t.add_column(col, justify="right" if col in ("worst line", "value", "limit") else "left")
     for r in results:
-        t.add_row(r.name, "[green]pass[/]" if r.ok else f"[red]FAIL[/] ({r.failing_lines} lines)",
-                  str(r.worst_line) if r.worst_line else "–", f"{r.value:.4g} {r.unit}",
-                  f"{r.limit:g}", r.detail)
+        t.add_row(r.name, _verdict(r), str(r.worst_line) if r.worst_line else "–",
+                  f"{r.value:.4g} {r.unit}", f"{r.limit:g}", r.detail)
     return t
 
 
 def main(argv: list[str] | None = None) -> int:
     """Entry point of ``check-plan``; returns the exit code."""
-    from rich.console import Console
-
     from robot.plan_sidecar import read_sidecar, sidecar_path
+    from robot.text_console import text_console
 
     try:
         args = _parser().parse_args(argv)
     except SystemExit as exc:
         return int(exc.code or 0)
-    err = Console(stderr=True)
+    # Messages carry file names, joint names and `file:line:col`: printed verbatim (no
+    # emoji codes such as :100:, no markup, no highlighting).
+    err = text_console(stderr=True)
     logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
     path = Path(args.plan)
     try:
@@ -98,22 +108,22 @@ def main(argv: list[str] | None = None) -> int:
         traj = _read(path, rate, robot)
         results = check_plan(traj, sidecar, spec, robot, rate, args.every, str(path))
     except InputError as exc:
-        err.print(f"check-plan: {exc}", markup=False, highlight=False, soft_wrap=True)
+        err.print(f"check-plan: {exc}", soft_wrap=True)
         return 2
     except HuboLadderError as exc:
-        err.print(f"check-plan: {exc}", markup=False, highlight=False, soft_wrap=True)
+        err.print(f"check-plan: {exc}", soft_wrap=True)
         return 1
-    out = Console()
+    out = text_console()
     if not out.is_terminal:  # a log file or a pipe: keep each row on one line
-        out = Console(width=200)
+        out = text_console(width=200)
     out.print(_table(results, f"check-plan {path} ({len(traj)} lines, {spec.name}, {robot})"))
     failed = [r for r in results if not r.ok]
     if failed:
         for r in failed:
             err.print(f"check-plan: {r.name} fails at line {r.worst_line}: {r.detail}",
-                      markup=False, highlight=False, soft_wrap=True)
+                      soft_wrap=True)
         return 1
-    err.print(f"check-plan: all {len(results)} checks pass", highlight=False)
+    err.print(f"check-plan: all {len(results)} checks pass")
     return 0
 
 
