@@ -8,14 +8,13 @@
 from __future__ import annotations
 
 import argparse
-import sys
 from dataclasses import fields
 from pathlib import Path
 
 from ladders.geometry import LadderGeometry
 from ladders.loader import load_ladder
 from ladders.spec import FIELD_RULES, LadderSpec
-from robot.errors import InputError
+from robot.errors import run_cli
 
 
 def parameter_rows(spec: LadderSpec) -> list[tuple[str, str, str, str]]:
@@ -108,8 +107,4 @@ def main(argv: list[str] | None = None) -> int:
     check.add_argument("file")
     check.set_defaults(run=_check)
     args = parser.parse_args(argv)
-    try:
-        return args.run(args)
-    except InputError as exc:
-        print(f"python -m ladders: {exc}", file=sys.stderr)
-        return 2
+    return run_cli("python -m ladders", lambda: args.run(args))

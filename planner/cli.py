@@ -28,7 +28,7 @@ from pathlib import Path
 from planner.holds import FOOT_COP_MARGIN_M, FOOT_FRICTION_SHARE
 from planner.statics.arm_capacity import DEFAULT_POSITION_TORQUE_SHARE
 from robot.constants import DAEMON_RATE_HZ
-from robot.errors import HuboLadderError, InputError
+from robot.errors import InputError, run_cli
 
 __all__ = ["main"]
 
@@ -231,15 +231,13 @@ def main(argv: list[str] | None = None) -> int:
         # toppra warns about every path its LP solver finds numerically uncontrollable;
         # planner.timing retries and falls back on those and logs that itself (at INFO).
         logging.getLogger("toppra").setLevel(logging.ERROR)
-    try:
-        _check_args(args)
-        return _plan(args, err)
-    except InputError as exc:
-        err.print(f"plan-ladder: {exc}", markup=False, highlight=False, soft_wrap=True)
-        return 2
-    except HuboLadderError as exc:
-        err.print(f"plan-ladder: {exc}", markup=False, highlight=False, soft_wrap=True)
-        return 1
+    return run_cli("plan-ladder", lambda: _run(args, err))
+
+
+def _run(args: argparse.Namespace, err) -> int:
+    """Check the flags, plan, write the files; the exit code (1: no plan found)."""
+    _check_args(args)
+    return _plan(args, err)
 
 
 if __name__ == "__main__":

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from planner.verify.check import CheckResult, check_plan
-from robot.errors import HuboLadderError, InputError, TrajectoryFileError
+from robot.errors import InputError, TrajectoryFileError, run_cli
 from robot.plan_sidecar import PlanSidecar
 
 __all__ = ["main"]
@@ -83,36 +83,35 @@ def _table(results: list[CheckResult], title: str):
 
 def main(argv: list[str] | None = None) -> int:
     """Entry point of ``check-plan``; returns the exit code."""
-    from robot.plan_sidecar import read_sidecar, sidecar_path
-    from robot.text_console import text_console
-
     try:
         args = _parser().parse_args(argv)
     except SystemExit as exc:
         return int(exc.code or 0)
-    # Messages carry file names, joint names and `file:line:col`: printed verbatim (no
-    # emoji codes such as :100:, no markup, no highlighting).
-    err = text_console(stderr=True)
+    # Messages carry file names, joint names and `file:line:col`: they are printed
+    # verbatim (run_cli prints plain text; the table through text_console: no emoji codes
+    # such as :100:, no markup, no highlighting).
     logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
+    return run_cli("check-plan", lambda: _check(args))
+
+
+def _check(args: argparse.Namespace) -> int:
+    """Check the plan of ``args``, print the table; the exit code (1: a check fails)."""
+    from robot.plan_sidecar import read_sidecar, sidecar_path
+    from robot.text_console import text_console
+
+    err = text_console(stderr=True)
     path = Path(args.plan)
-    try:
-        if args.every < 1:
-            raise InputError(f"--every must be ≥ 1, got {args.every}")
-        side = sidecar_path(path)
-        if not side.exists():
-            raise InputError(f"{path}: its sidecar {side} is missing")
-        sidecar = read_sidecar(side)
-        robot = args.robot or sidecar.robot
-        rate = args.rate or sidecar.rate_hz
-        spec = _ladder(args, sidecar, str(side))
-        traj = _read(path, rate, robot)
-        results = check_plan(traj, sidecar, spec, robot, rate, args.every, str(path))
-    except InputError as exc:
-        err.print(f"check-plan: {exc}", soft_wrap=True)
-        return 2
-    except HuboLadderError as exc:
-        err.print(f"check-plan: {exc}", soft_wrap=True)
-        return 1
+    if args.every < 1:
+        raise InputError(f"--every must be ≥ 1, got {args.every}")
+    side = sidecar_path(path)
+    if not side.exists():
+        raise InputError(f"{path}: its sidecar {side} is missing")
+    sidecar = read_sidecar(side)
+    robot = args.robot or sidecar.robot
+    rate = args.rate or sidecar.rate_hz
+    spec = _ladder(args, sidecar, str(side))
+    traj = _read(path, rate, robot)
+    results = check_plan(traj, sidecar, spec, robot, rate, args.every, str(path))
     out = text_console()
     if not out.is_terminal:  # a log file or a pipe: keep each row on one line
         out = text_console(width=200)
