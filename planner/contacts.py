@@ -1,9 +1,11 @@
 """Holds and stances: which limb touches what, through which point contacts (thesis §6.3.1).
 
-A foot hold is the part of the sole resting on a rung: the sole corners clipped to the
-rung's tread, each a point contact pushing up. A hand hold is a palm closed on a rail:
-one contact that pushes up (the hand can lean down on the rail) and one that pulls the
-hand towards the ladder (the fingers pull back). All contacts carry Coulomb friction μ.
+A foot hold is the part of the sole resting on a rung: the corners of its contact patch
+(`ladders.contact_model.FootPatch`), each a point contact pushing up with Coulomb
+friction μ. A hand hold is a palm closed on a rail: a wrench contact whose limits are the
+grip's (`ladders.contact_model.HandLimits`). A hand hold without limits is the thesis's
+point hold: one contact that pushes up and one that pulls the hand towards the ladder,
+both with friction μ (the CoM tests of `planner.statics.stability` still take it).
 """
 
 from __future__ import annotations
@@ -11,6 +13,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+
+from ladders.contact_model import FootPatch, HandLimits
 
 LIMBS = ("left_hand", "right_hand", "left_foot", "right_foot")
 #: Operational frame of each limb in the robot model.
@@ -29,6 +33,9 @@ class Hold:
         points_m: (k, 3) contact points in the world frame [m].
         normals: (k, 3) unit contact normals (force on the robot pushes along them).
         friction: Coulomb coefficient μ of every contact.
+        limits: the contact's limits (`ladders.contact_model`): a hand's grip, which
+            replaces its points in the torque LP, or the foot's patch the points are the
+            corners of; None for a bare set of point contacts.
     """
 
     limb: str
@@ -37,6 +44,7 @@ class Hold:
     points_m: np.ndarray = field(repr=False)
     normals: np.ndarray = field(repr=False)
     friction: float = 0.4
+    limits: HandLimits | FootPatch | None = field(default=None, repr=False)
 
     @property
     def frame(self) -> str:

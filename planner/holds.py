@@ -4,18 +4,17 @@ from __future__ import annotations
 
 import numpy as np
 
+from ladders.contact_model import GRIP_RESERVE, FootPatch, hand_limits, sole_patch_x
 from ladders.geometry import LadderGeometry
 from planner.contacts import Hold
 from primitives.hold_seeds import FloorSeed, HoldSeed, RailSeed, RungSeed
 from robot.params import RobotParams
 
-#: A cylinder rung supports the sole along a line; model it as a strip this wide [m].
-CYLINDER_SUPPORT_STRIP_M = 0.01
-
 
 def half_tread_m(spec) -> float:
-    """Half the depth of a rung's tread that supports a sole [m] (a cylinder's strip)."""
-    return spec.rung_depth_m / 2 if spec.rung_shape == "box" else CYLINDER_SUPPORT_STRIP_M / 2
+    """Half the depth of a rung's tread that supports a sole [m]: 0 on a round rung,
+    which supports it along a line (`ladders.contact_model.sole_patch_x`)."""
+    return spec.rung_depth_m / 2 if spec.rung_shape == "box" else 0.0
 
 
 def _pose(R: np.ndarray, p: np.ndarray) -> np.ndarray:
@@ -120,25 +119,35 @@ def sole_contact_points(params: RobotParams, T_world_sole: np.ndarray,
     """Four corners of the sole part between ``x_range_m`` (sole frame x), each side
     ``margin_m`` inwards (along x only where the part is wider than twice that) [m],
     world."""
-    hy = params.foot_width_m / 2 - margin_m
-    (x0, x1) = x_range_m
-    if x1 - x0 > 2 * margin_m:
-        x0, x1 = x0 + margin_m, x1 - margin_m
-    local = np.array([[x1, hy, 0], [x1, -hy, 0], [x0, -hy, 0], [x0, hy, 0]], dtype=float)
-    return local @ T_world_sole[:3, :3].T + T_world_sole[:3, 3]
+    patch = FootPatch(tuple(x_range_m), params.foot_width_m / 2, 0.0).shrunk(margin_m)
+    return _to_world(T_world_sole, patch.corners())
+
+
+def _to_world(T: np.ndarray, local: np.ndarray) -> np.ndarray:
+    return local @ T[:3, :3].T + T[:3, 3]
+
+
+def foot_patch(params: RobotParams, x_range_m: tuple[float, float], friction: float,
+               margin_m: float) -> FootPatch:
+    """The patch a sole's centre of pressure may use: the sole part ``x_range_m`` (sole
+    frame x) ``margin_m`` inside its sides, at ``friction``."""
+    return FootPatch(tuple(x_range_m), params.foot_width_m / 2, friction).shrunk(margin_m)
 
 
 def make_hold(seed: HoldSeed, geom: LadderGeometry, params: RobotParams,
               floor_pose: dict[str, np.ndarray] | None = None, offset_m=(0.0, 0.0),
               shoulder_m: np.ndarray | None = None, grip_style: str = "facing",
               cop_margin_m: float = FOOT_COP_MARGIN_M,
-              friction_share: float = FOOT_FRICTION_SHARE) -> Hold:
+              friction_share: float = FOOT_FRICTION_SHARE,
+              grip_share: float = GRIP_RESERVE) -> Hold:
     """A concrete hold for a seed, shifted by ``offset_m`` = (along, lateral) in L [m].
 
     A rail hold takes a ``grip_style`` (see `palm_rotation`); the ``shoulder`` style needs
-    ``shoulder_m``, the current position of that arm's shoulder [m]. A foot hold's
-    contact corners keep its centre of pressure ``cop_margin_m`` inside the support, and
-    its friction is ``friction_share`` of the ladder's μ.
+    ``shoulder_m``, the current position of that arm's shoulder [m]. Its limits are the
+    grip's (`ladders.contact_model.hand_limits`), of which it may use ``grip_share``.
+    A foot hold's contact patch (`ladders.contact_model`: the sole ∩ tread overlap, a
+    line on a round rung) keeps its centre of pressure ``cop_margin_m`` inside its
+    sides, and its friction is ``friction_share`` of the ladder's μ.
     """
     mu = geom.spec.friction
     foot_mu = mu * friction_share
@@ -146,19 +155,21 @@ def make_hold(seed: HoldSeed, geom: LadderGeometry, params: RobotParams,
     hl = params.foot_length_m / 2
     if isinstance(seed, FloorSeed):
         T = floor_pose[seed.limb]
-        pts = sole_contact_points(params, T, (-hl, hl), cop_margin_m)
-        return Hold(seed.limb, "floor", T, pts, np.tile(up, (4, 1)), foot_mu)
+        patch = foot_patch(params, (-hl, hl), foot_mu, cop_margin_m)
+        return Hold(seed.limb, "floor", T, _to_world(T, patch.corners()), np.tile(up, (4, 1)),
+                    foot_mu, limits=patch)
     if isinstance(seed, RungSeed):
         along, lateral = seed.along_m + offset_m[0], seed.lateral_m + offset_m[1]
         p = geom.rung_top_point(seed.rung, lateral_m=lateral, along_m=along)
         T = _pose(geom.R_world_ladder, p)
-        half_tread = half_tread_m(geom.spec)
-        # The tread spans [-along - half, -along + half] in the sole frame; clip to the sole.
-        x0, x1 = max(-hl, -along - half_tread), min(hl, -along + half_tread)
-        if x1 <= x0:
+        # The tread's centre lies at -along in the sole frame.
+        x_range = sole_patch_x(geom.spec.rung_shape, half_tread_m(geom.spec), -along,
+                               params.foot_length_m)
+        if x_range is None:
             raise ValueError(f"the sole does not overlap rung {seed.rung} at offset {along} m")
-        pts = sole_contact_points(params, T, (x0, x1), cop_margin_m)
-        return Hold(seed.limb, seed.target, T, pts, np.tile(up, (4, 1)), foot_mu)
+        patch = foot_patch(params, x_range, foot_mu, cop_margin_m)
+        return Hold(seed.limb, seed.target, T, _to_world(T, patch.corners()),
+                    np.tile(up, (4, 1)), foot_mu, limits=patch)
     if isinstance(seed, RailSeed):
         along = seed.along_m
         if seed.torso_along_m is not None:
@@ -166,8 +177,11 @@ def make_hold(seed: HoldSeed, geom: LadderGeometry, params: RobotParams,
                                                      seed.torso_along_m))
         p = rail_point(geom, seed.side, seed.rung, along + offset_m[0])
         T = _pose(palm_rotation(geom, seed.side, p, shoulder_m, grip_style), p)
-        # Thesis hand hold: a contact pushing up and one pulling the hand towards the ladder.
+        # The thesis's point hold (a contact pushing up and one pulling the hand towards
+        # the ladder) stays as the hold's points; the torque LP and the CoM region take
+        # the grip's wrench limits instead.
         towards_ladder = geom.R_world_ladder @ np.array([1.0, 0.0, 0.0])
+        limits = hand_limits(mu, geom.spec.rail_radius_m, geom.ladder_direction, grip_share)
         return Hold(seed.limb, seed.target, T, np.vstack([p, p]),
-                    np.vstack([up, towards_ladder]), mu)
+                    np.vstack([up, towards_ladder]), mu, limits=limits)
     raise TypeError(f"unknown seed {seed!r}")

@@ -19,6 +19,7 @@ from daemon.joint_control import JointController  # noqa: E402
 from daemon.pwm import default_drc_gains  # noqa: E402
 from daemon.sim.board_model import PlacementError  # noqa: E402
 from daemon.sim.grasp_latch import GripCapacity, GripConfig  # noqa: E402
+from ladders.contact_model import GripGeometry  # noqa: E402
 from execute.validate.metrics import compute_metrics  # noqa: E402
 from execute.validate.simulate import SimulationOptions, simulate  # noqa: E402
 from ladders.spec import LadderSpec  # noqa: E402
@@ -76,9 +77,9 @@ def _hold(run, ticks: int, ref: np.ndarray, extra=None, limp_arm: str | None = N
 
 def test_capacity_from_finger_torque():
     cfg = GripConfig()
-    cap = GripCapacity.of(cfg, friction=0.4, rail_radius_m=0.025)
+    cap = GripCapacity.of(cfg.grip, friction=0.4, rail_radius_m=0.025)
     assert cap.radial_n == pytest.approx(5 * 5.0 / 0.06)
-    assert cap.squeeze_n == pytest.approx(5 * cfg.finger_squeeze_nm / 0.06)
+    assert cap.squeeze_n == pytest.approx(5 * cfg.grip.finger_squeeze_nm / 0.06)
     # fingers and palm each press the rail with the squeeze, one of them also with the load
     assert cap.along_n(100.0) == pytest.approx(0.4 * (2 * cap.squeeze_n + 100.0))
     assert cap.about_nm(100.0) == pytest.approx(cap.along_n(100.0) * 0.025)
@@ -87,7 +88,7 @@ def test_capacity_from_finger_torque():
     assert parts["radial force"] == pytest.approx(1.5)
     assert max(parts, key=parts.get) == "radial force"
     # a hook that does not squeeze holds nothing along a rail nothing presses it onto
-    hook = GripCapacity.of(GripConfig(finger_squeeze_nm=0.0), friction=0.4,
+    hook = GripCapacity.of(GripGeometry(finger_squeeze_nm=0.0), friction=0.4,
                            rail_radius_m=0.025)
     along = hook.utilisation(np.array([0.0, 0.0, 10.0]), np.zeros(3), axis)
     assert along["force along the rail"] == math.inf
@@ -107,7 +108,8 @@ def test_palm_off_the_rail_grasps_nothing(plan):
     traj, sc, ladder = plan
     # ladder 11.5 cm further away: the rails sit ≈ 10 cm beyond the closing palms
     run = simulate(traj, sc, ladder, SimulationOptions(
-        strategy="position", placement=PlacementError(0.115, 0.0, 0.0), record_qpos=False))
+        strategy="position", placement=PlacementError(0.115, 0.0, 0.0), record_qpos=False,
+        closed_loop=False))
     assert not any(g.kind == "latched" for g in run.log.grasps)
     missed = [g for g in run.log.grasps if g.kind == "missed"]
     assert missed and all(0.08 < g.distance_m < 0.12 for g in missed)

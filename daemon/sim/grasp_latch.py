@@ -11,8 +11,9 @@ sagged) is drawn onto the axis; a compliant arm gives way, a stiff one fights th
 
 When it latches (all of):
 
-- the fingers are commanded closed (sent reference ≥ ``closed_fraction`` ·
-  ``FINGER_CLOSED_RAD``) and their mean curl reaches the rail: the curl at which a finger
+- the fingers are driven closed (sent reference at least ``open_fraction`` ·
+  ``FINGER_CLOSED_RAD``, where an opening would release) and their mean curl has reached
+  the rail: the curl at which a finger
   meets a rail lying at the grip centre (`robot.kinematic_tree.finger_contact_curl_rad`,
   0.09 rad for a 25 mm rail). The board model keeps fingers from colliding with the
   rails (their single-link capsules' curl sweeps through the grip centre): the grip is
@@ -40,7 +41,7 @@ weld's anchor is moved about (or along) the rail, by the share of the hand's off
 from it that leaves the weld's spring carrying only the capacity. `slip_rad` and
 `slip_m` add up how far the hand turned and slid.
 
-The fingers close round the rail and press it with ``finger_squeeze_nm`` each, 1 N·m by
+The fingers close round the rail and press it with the grip's ``finger_squeeze_nm`` each, 1 N·m by
 default, a fifth of their limit:
 
 - not at the limit: a grip that squeezed with all five fingers at their limit (8.3 N·m
@@ -53,23 +54,12 @@ default, a fifth of their limit:
   along it). The DRC mount's holds need up to 65 N of squeeze, 0.78 N·m a finger; with
   none the hands slid 2–3 cm down the rails and a hip roll's board tripped at 31 s.
 
-Capacities: the squeeze and the fingers' strength set what the grip holds:
-
-======================  ====================================  ========================
-load on the hand        capacity                              DRC-Hubo, μ = 0.4
-======================  ====================================  ========================
-radial force            ``N = n·τ_f / ℓ``                     5·5/0.06 = 417 N
-bending torque          ``(τ_f/ℓ)·Σ|x_i|`` (finger couple)      9.0 N·m
-force along the rail    ``μ·(2·S + F_r)``, ``S = n·τ_s / ℓ``  67 N + 0.4·F_r
-torque about the rail   ``μ·(2·S + F_r)·r_rail``              1.7 N·m + 0.01 m·F_r
-======================  ====================================  ========================
-
-``F_r`` is the load across the rail (fingers and palm each press with ``S``, one of them
-also with ``F_r``), ``τ_f`` a finger's torque limit (hubo-facts §5: ≈ 5 N·m), ``τ_s``
-its squeeze, ``ℓ = 0.06 m`` the finger-joint-to-rail-axis lever at the grip centre
-(finger joints 4.5 cm above and 4 cm beside it: ``√(0.045² + 0.04²)``), ``x_i`` the
-finger positions along the grip axis (±36, ±18, 0 mm), ``μ`` the ladder's friction,
-``r_rail`` = 25 mm on the bundled ladders. The load is the weld's constraint wrench on the
+Capacities: the squeeze and the fingers' strength set what the grip holds. They are the
+contact model's (`ladders.contact_model.GripCapacity`, from the Hubo hand's
+`ladders.contact_model.GripGeometry`), the same limits the planner plans hand wrenches
+within (with a reserve) and check-plan checks: radial force 417 N and bending torque
+9.0 N·m release the grip; along the rail 67 N + μ·F_r and about it 1.7 N·m + 0.01 m·F_r
+(μ = 0.4, 25 mm rail) make it slip. The load is the weld's constraint wrench on the
 hand, about the palm site, split along and across the rail. ``slip_persistence_s =
 10 ms`` (two ticks) only filters single-step constraint spikes at impacts; it is not a
 tuning knob.
@@ -78,19 +68,26 @@ tuning knob.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from enum import Enum
 
 import mujoco
 import numpy as np
 
+from ladders.contact_model import (
+    RELEASE_LOADS,
+    SLIP_LOADS,
+    GripCapacity,
+    GripGeometry,
+    default_grip,
+)
 from robot.kinematic_tree import FINGER_CLOSED_RAD, finger_contact_curl_rad
 
 __all__ = ["RELEASE_LOADS", "SLIP_LOADS", "GraspEvent", "GraspLatch", "GripCapacity",
            "GripConfig", "GripState"]
-
-#: Finger positions along the grip axis [m] (robot.kinematic_tree: −0.036 + 0.018·i).
-FINGER_X_M = (-0.036, -0.018, 0.0, 0.018, 0.036)
+#: A latched grip's load is kept every this long [s] (`GraspLatch.load_history`), for
+#: validate-plan's comparison with the plan's hold wrenches.
+LOAD_SAMPLE_S = 0.1
 #: ``efc_type`` of an equality's constraint rows as a plain int: numpy compares an array
 #: with the binding's enum object element by element, a hundred times slower.
 _EQUALITY_ROW = int(mujoco.mjtConstraint.mjCNSTR_EQUALITY)
@@ -102,13 +99,12 @@ class GripConfig:
 
     Attributes:
         closed_fraction: share of ``FINGER_CLOSED_RAD`` at which fingers count closed.
-        open_fraction: share of it below which a commanded opening releases.
+        open_fraction: share of it below which a commanded opening releases; fingers
+            stopped on a rail grip it once their reference is past this share.
         position_tolerance_m: palm site to rail axis [m].
         angle_tolerance_rad: grip axis to rail direction [rad].
-        finger_torque_nm: torque limit of one finger [N·m].
-        finger_squeeze_nm: torque each closed finger presses the rail with [N·m]
-            (module docstring: why 1).
-        finger_lever_m: finger joint to rail axis at the grip centre [m].
+        grip: the hand's fingers and their torques (`ladders.contact_model`; the Hubo
+            hand's by default, the planner's and check-plan's too).
         slip_persistence_s: how long an overload must last to release [s].
     """
 
@@ -116,65 +112,8 @@ class GripConfig:
     open_fraction: float = 0.5
     position_tolerance_m: float = 0.02
     angle_tolerance_rad: float = math.radians(20.0)
-    finger_torque_nm: float = 5.0
-    finger_squeeze_nm: float = 1.0
-    finger_lever_m: float = 0.06
+    grip: GripGeometry = field(default_factory=default_grip)
     slip_persistence_s: float = 0.01
-
-
-@dataclass(frozen=True)
-class GripCapacity:
-    """What a closed hand can carry on a rail (module docstring table)."""
-
-    radial_n: float
-    bending_nm: float
-    squeeze_n: float
-    friction: float
-    rail_radius_m: float
-
-    @classmethod
-    def of(cls, cfg: GripConfig, friction: float, rail_radius_m: float) -> GripCapacity:
-        per_finger = cfg.finger_torque_nm / cfg.finger_lever_m
-        n = len(FINGER_X_M)
-        return cls(per_finger * n, per_finger * sum(abs(x) for x in FINGER_X_M),
-                   n * cfg.finger_squeeze_nm / cfg.finger_lever_m, friction, rail_radius_m)
-
-    def along_n(self, radial_load_n: float) -> float:
-        """Friction along the rail under a load ``radial_load_n`` across it [N]: the
-        fingers and the palm each press the rail with the squeeze, one of them also with
-        the load."""
-        return self.friction * (2.0 * self.squeeze_n + radial_load_n)
-
-    def about_nm(self, radial_load_n: float) -> float:
-        """Friction torque about the rail under a load ``radial_load_n`` across it [N·m]."""
-        return self.along_n(radial_load_n) * self.rail_radius_m
-
-    def utilisation(self, force_n: np.ndarray, torque_nm: np.ndarray,
-                    axis: np.ndarray) -> dict[str, float]:
-        """Load / capacity ratio of each component (`SLIP_LOADS` and `RELEASE_LOADS`); a
-        load along or about an unloaded rail is infinitely over what friction holds."""
-        fa = float(force_n @ axis)
-        ta = float(torque_nm @ axis)
-        radial = _norm(force_n - fa * axis)
-        return {
-            "radial force": radial / self.radial_n,
-            "force along the rail": _ratio(abs(fa), self.along_n(radial)),
-            "torque about the rail": _ratio(abs(ta), self.about_nm(radial)),
-            "bending torque": _norm(torque_nm - ta * axis) / self.bending_nm,
-        }
-
-
-def _ratio(load: float, capacity: float) -> float:
-    if capacity > 0.0:
-        return load / capacity
-    return math.inf if load > 0.0 else 0.0
-
-
-#: Loads a closed hand gives way to by slipping on its rail (still latched), in the order
-#: `GraspLatch._slip` reads them: along, about.
-SLIP_LOADS = ("force along the rail", "torque about the rail")
-#: Loads that pull the rail out of the fingers or pry them open: the grip lets go.
-RELEASE_LOADS = ("radial force", "bending torque")
 
 
 class GripState(Enum):
@@ -254,7 +193,7 @@ class GraspLatch:
         self.finger_cols = np.asarray(finger_cols)
         self.rails = rails
         self.friction, self.rail_radius_m = friction, rail_radius_m
-        self.capacity = GripCapacity.of(self.config, friction, rail_radius_m)
+        self.capacity = GripCapacity.of(self.config.grip, friction, rail_radius_m)
         self.rail_contact_curl_rad = finger_contact_curl_rad(rail_radius_m)
         joint_of_qpos = {int(model.jnt_qposadr[j]): j for j in range(model.njnt)}
         self._finger_joints = np.array([joint_of_qpos[int(a)] for a in self.finger_qpos])
@@ -273,6 +212,9 @@ class GraspLatch:
         self.slip_m = self.slip_rad = 0.0
         self.peak_utilisation = 0.0
         self.last_utilisation = (0.0, "")
+        #: (time [s], force [N], torque [N·m]) of the grip's load, world frame, every
+        #: `LOAD_SAMPLE_S` while latched.
+        self.load_history: list[tuple[float, np.ndarray, np.ndarray]] = []
         self.data.eq_active[self.eq_id] = 0
         self._fingers_on_rail(False)
 
@@ -330,6 +272,8 @@ class GraspLatch:
             if opening:
                 return self._release(time_s, "fingers commanded open", GripState.OPEN)
             force, torque = self.grip_load()
+            if not self.load_history or time_s - self.load_history[-1][0] >= LOAD_SAMPLE_S:
+                self.load_history.append((time_s, force.copy(), torque.copy()))
             axis = self._rail_axis(self.rail)
             parts = self.capacity.utilisation(force, torque, axis)
             self._slip(parts, axis)
@@ -350,25 +294,29 @@ class GraspLatch:
                 self._passed_rail = False
             return None
         # OPEN
-        if not (closed_ref and finger_board_ok):
-            if curl < self.rail_contact_curl_rad:
-                self._passed_rail = False
+        if not finger_board_ok:
             return None
+        driven = not opening  # the reference is past where a commanded opening releases
         if curl < self.rail_contact_curl_rad:
-            return None  # still closing, not yet where a rail in the hand would stop them
+            if not driven:
+                self._passed_rail = False
+            return None  # not yet where a rail in the hand would stop them
         near = self.palm_to_rails()
         rail = min(near, key=lambda r: near[r][0])
         dist, ang = near[rail]
         within = dist <= cfg.position_tolerance_m and ang <= cfg.angle_tolerance_rad
         if within and not self._passed_rail:
-            self._fingers_on_rail(True)
+            self._fingers_on_rail(True)  # the rail in the grip stops the fingers
+            if not driven:
+                return None  # touching it, not yet squeezing
             self._latch(rail)
             return GraspEvent(self.hand, "latched", time_s, rail,
                               f"palm {dist * 100:.1f} cm from the axis, grip axis "
                               f"{math.degrees(ang):.0f}° off", dist, ang)
+        self._fingers_on_rail(False)
         self._passed_rail = True  # the fingers went past where a rail would stop them
-        if curl < cfg.closed_fraction * FINGER_CLOSED_RAD:
-            return None  # still closing, on nothing
+        if not closed_ref or curl < cfg.closed_fraction * FINGER_CLOSED_RAD:
+            return None  # not (yet) closed, on nothing
         self.state = GripState.CLOSED_EMPTY
         why = []
         if dist > cfg.position_tolerance_m:

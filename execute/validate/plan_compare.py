@@ -23,11 +23,15 @@ import mujoco
 import numpy as np
 
 from daemon.sim.board_model import TICK_S
-from robot.joints import JOINT_INDEX
+from ladders.contact_model import HandLimits
+from ladders.geometry import LadderGeometry
+from robot.joints import FINGER_JOINTS, JOINT_INDEX
 from robot.limits import joint_limits
 
-__all__ = ["JointLoad", "PlanComparison", "compare_with_plan", "planned_torque_history"]
+__all__ = ["GripAgreement", "JointLoad", "PlanComparison", "compare_with_plan", "grip_agreement",
+           "planned_torque_history"]
 
+FINGERS = frozenset(n for hand in FINGER_JOINTS.values() for n in hand)
 #: How many joints the comparison lists (the largest departures from the plan).
 JOINTS_LISTED = 6
 
@@ -60,6 +64,8 @@ class PlanComparison:
             applies to it, world frame [N]; simulated is None for a hand whose grip is
             not latched.
         planned_worst_ratio: the LP's worst |τ|/τmax at this line.
+        grips: per segment and held hand, planned against simulated grip load
+            (`grip_agreement`).
     """
 
     line: int
@@ -69,6 +75,7 @@ class PlanComparison:
     joints: tuple[JointLoad, ...]
     hold_forces_n: dict[str, tuple[np.ndarray, np.ndarray | None]]
     planned_worst_ratio: float
+    grips: tuple[GripAgreement, ...] = ()
 
     def summary(self) -> str:
         """One clause for the verdict's explanation."""
@@ -93,7 +100,87 @@ class PlanComparison:
                        for j in self.joints],
             "hold_forces_n": {limb: {"planned": vec(p), "simulated": vec(s)}
                               for limb, (p, s) in self.hold_forces_n.items()},
+            "grips_by_segment": [g.to_json() for g in self.grips],
+            "grip_departure_median": (None if not self.grips else round(float(
+                np.median([g.departure for g in self.grips])), 3)),
         }
+
+
+@dataclass(frozen=True)
+class GripAgreement:
+    """A held hand's planned against simulated grip load in one segment, each of
+    `ladders.contact_model.GRIP_LOADS` as a share of the grip's whole capacity.
+
+    Attributes:
+        segment: the sidecar segment's index; label: its primitive/phase.
+        limb: the hand; line: the line compared (the latch's sample nearest the
+            segment's middle); time_s: the sample's simulated time [s].
+        planned, simulated: load → share of its limit (check-plan's LP; the latch's
+            `grip_load`).
+    """
+
+    segment: int
+    label: str
+    limb: str
+    line: int
+    time_s: float
+    planned: dict[str, float]
+    simulated: dict[str, float]
+
+    @property
+    def departure(self) -> float:
+        """max |simulated − planned| over the loads, as a share of the limit."""
+        return max(abs(self.simulated[k] - self.planned[k]) for k in self.planned)
+
+    def to_json(self) -> dict[str, Any]:
+        return {"segment": self.segment, "label": self.label, "limb": self.limb,
+                "line": self.line, "time_s": round(self.time_s, 2),
+                "planned": {k: round(v, 3) for k, v in self.planned.items()},
+                "simulated": {k: round(v, 3) for k, v in self.simulated.items()},
+                "departure": round(self.departure, 3)}
+
+
+def grip_agreement(run, trajectory_rad: np.ndarray, ladder) -> tuple[GripAgreement, ...]:
+    """Per segment and held hand, the plan's grip load (check-plan's torque LP, the
+    contact model's limits) against the latch's (`GraspLatch.load_history`), at the
+    latch's sample nearest the segment's middle."""
+    from planner.verify.check import planned_loads
+
+    log = run.log
+    picks = []  # (segment, limb, line, time, force, torque)
+    for k, seg in enumerate(run.sidecar.segments):
+        for limb in seg.holds:
+            if not limb.endswith("hand"):
+                continue
+            hist = run.board.latches[limb.removesuffix("_hand")].load_history
+            best = None
+            mid = 0.5 * (seg.first_line + seg.last_line)
+            for t, f, tq in hist:
+                i = min(int(np.searchsorted(log.time_s, t)), len(log.time_s) - 1)
+                line = int(log.line_index[i]) + 1
+                if seg.first_line <= line <= seg.last_line and (
+                        best is None or abs(line - mid) < abs(best[0] - mid)):
+                    best = (line, t, f, tq)
+            if best is not None:
+                picks.append((k, limb, *best))
+    if not picks:
+        return ()
+    axis = LadderGeometry(ladder).ladder_direction
+    plans = planned_loads(trajectory_rad, run.sidecar, ladder, [p[2] for p in picks],
+                          run.board.robot)
+    out = []
+    for (k, limb, line, t, f, tq), plan in zip(picks, plans, strict=True):
+        if plan.torque is None or not plan.torque.equilibrium:
+            continue
+        planned = plan.torque.contact_use.get(limb)
+        if planned is None:
+            continue
+        # the latch's capacity is the contact model's; the rail runs up the rung line
+        lim = HandLimits(run.board.latches[limb.removesuffix("_hand")].capacity, axis)
+        seg = run.sidecar.segments[k]
+        out.append(GripAgreement(k, f"{seg.primitive}/{seg.phase}", limb, line, t, planned,
+                                 lim.utilisation(f, tq)))
+    return tuple(out)
 
 
 def _body_contact_force(model: mujoco.MjModel, data: mujoco.MjData, body: int) -> np.ndarray:
@@ -129,10 +216,11 @@ def compare_with_plan(run, trajectory_rad: np.ndarray, ladder) -> PlanComparison
     # The tick before the last: a board that tripped on the last one reports no torque.
     tau_sim = run.log.torque_nm[max(len(run.log.torque_nm) - 2, 0)]
     tmax = joint_limits(board.robot).torque_max_nm
+    # Fingers are not the LP's: a closed hand's fingers press its rail at their own limit.
     loads = [JointLoad(n, float(plan.torque.torques_nm[k]),
                        float(tau_sim[JOINT_INDEX[n]]), float(tmax[JOINT_INDEX[n]]))
              for k, n in enumerate(plan.torque.joint_names)
-             if n in JOINT_INDEX and tmax[JOINT_INDEX[n]] > 0]
+             if n in JOINT_INDEX and tmax[JOINT_INDEX[n]] > 0 and n not in FINGERS]
     loads.sort(key=lambda j: j.departure, reverse=True)
     holds: dict[str, tuple[np.ndarray, np.ndarray | None]] = {}
     for limb, f in plan.torque.forces_n.items():
@@ -145,7 +233,8 @@ def compare_with_plan(run, trajectory_rad: np.ndarray, ladder) -> PlanComparison
             sim = _body_contact_force(m, d, body)
         holds[limb] = (f.sum(axis=0), sim)
     return PlanComparison(line, board.time_s, d.qpos[:3] - plan.base_pose[:3, 3], turn,
-                          tuple(loads[:JOINTS_LISTED]), holds, plan.torque.max_ratio)
+                          tuple(loads[:JOINTS_LISTED]), holds, plan.torque.max_ratio,
+                          grip_agreement(run, trajectory_rad, ladder))
 
 
 def planned_torque_history(run, trajectory_rad: np.ndarray, ladder, joints: list[str],

@@ -9,10 +9,16 @@ Two tests, both on linearised Coulomb friction cones (thesis §6.3.1, μ = 0.4):
    is the projection of a polytope onto (x, y); it is computed by the iterative LP method
    (inner and outer polygons refined until their area gap is small). Computed once per
    stance; `SupportRegion.margin` is then a cheap per-configuration test.
-2. `torque_feasibility` — with hands gripping, the CoM test alone lets almost anything
-   pass: a hand can pull hard enough to hold any CoM. This LP balances the generalized
-   gravity of a configuration with contact forces, exactly on the free-flyer rows, and
-   minimises the worst joint-torque ratio max_j |τ_j| / τmax_j.
+2. `torque_feasibility` — with hands gripping, the CoM test alone lets much pass: a
+   hand can pull hard enough to hold a CoM far from the feet. This LP balances the
+   generalized gravity of a configuration with contact wrenches, exactly on the
+   free-flyer rows, and minimises the worst joint-torque ratio max_j |τ_j| / τmax_j.
+
+Contacts (`ladders.contact_model`, issue 22): a foot is point contacts at the corners of
+its contact patch, in friction cones; a hand with grip limits (``Hold.limits``, a
+`ladders.contact_model.HandLimits`) is a 6-D wrench about its palm frame inside the
+linearised grip capacity, the same limits the MuJoCo latch lets go at. Among equally good
+load shares the LP takes the one that loads the grips least (`GRIP_LOAD_COST`).
 
 The CoM region is exactly the set of CoM positions for which the free-flyer rows of the
 torque LP are feasible (same contacts, same cones), so a configuration whose CoM lies
@@ -33,7 +39,8 @@ from functools import lru_cache
 import numpy as np
 from scipy.optimize import linprog
 
-from planner.contacts import LIMB_FRAME, Stance
+from ladders.contact_model import FootPatch, HandLimits
+from planner.contacts import LIMB_FRAME, Hold, Stance
 from robot.constants import GRAVITY_M_S2
 from robot.errors import HuboLadderError
 
@@ -51,7 +58,21 @@ __all__ = [
     "support_region",
     "torque_feasibility",
     "torque_limits_by_joint",
+    "GRIP_LOAD_COST",
+    "OBJECTIVES",
 ]
+
+#: Cost of a hand's wrench in the torque LP, per unit of its use of the grip (each
+#: component as a share of its radial or bending capacity), against 1 per unit of the
+#: worst joint ratio. The min-max optimum leaves the share of the load between grips and
+#: feet free (only the worst joint counts); without a cost HiGHS returns any vertex of
+#: that face, often a grip at its limit. The compliant arms give less than the LP asks
+#: (`planner.statics.arm_capacity`), so among equal optima the least-loaded grip is the
+#: plan the robot follows best. Small enough to move the optimum's ratio by < 0.005.
+GRIP_LOAD_COST = 1e-3
+#: What `torque_feasibility` minimises: the worst joint ratio (the planner's test), or the
+#: worst grip utilisation with the joints within their limits (check-plan's contact check).
+OBJECTIVES = ("torque", "contact")
 
 
 class StabilityError(HuboLadderError):
@@ -257,29 +278,67 @@ def _edge_gap(vi, vj, d_out_i, d_in_j, n_e) -> float:
     return 0.5 * abs(e[0] * r[1] - e[1] * r[0])
 
 
-class _ProjectionLP:
-    """max d·c over the static-equilibrium polytope in (λ, c_xy), for varying d."""
+def _skew(v: np.ndarray) -> np.ndarray:
+    return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
 
-    def __init__(self, points: np.ndarray, edges: np.ndarray, box_half_m: float):
+
+def _split_wrench_basis(offset_m: np.ndarray) -> np.ndarray:
+    """(6, 12): a wrench (force, torque about a point ``offset_m`` from the moment origin)
+    as the difference of two non-negative 6-vectors, mapped to (force, moment about the
+    origin)."""
+    w = np.eye(6)
+    w[3:, :3] = _skew(offset_m)
+    return np.hstack([w, -w])
+
+
+def _grip_rows(limits: HandLimits, weight_n: float) -> tuple[np.ndarray, np.ndarray]:
+    """A grip's halfspaces on its split wrench variables (body weights): (m, 12), (m,)."""
+    a, b = limits.halfspaces()
+    return np.hstack([a, -a]), b / weight_n
+
+
+def _cone_and_grip_holds(stance: Stance) -> tuple[list[Hold], list[Hold]]:
+    grips = [h for h in stance.holds if isinstance(h.limits, HandLimits)]
+    return [h for h in stance.holds if not isinstance(h.limits, HandLimits)], grips
+
+
+class _ProjectionLP:
+    """max d·c over the static-equilibrium polytope in (λ, y, c_xy), for varying d: λ the
+    cone coefficients of the point contacts, y the split wrenches of the grips."""
+
+    def __init__(self, points: np.ndarray, edges: np.ndarray, box_half_m: float,
+                 grips: tuple[tuple[np.ndarray, np.ndarray, np.ndarray], ...] = (),
+                 wrench_max: float = np.inf):
         n_lam = edges.shape[0] * edges.shape[1]
-        self.center = points[:, :2].mean(axis=0)
-        origin = np.array([*self.center, points[:, 2].mean()])
-        rel = points - origin  # moments about the contacts' centroid, for conditioning
+        n_y = 12 * len(grips)
+        n = n_lam + n_y
+        all_pts = np.vstack([points.reshape(-1, 3)] + [g[0][None] for g in grips])
+        self.center = all_pts[:, :2].mean(axis=0)
+        origin = np.array([*self.center, all_pts[:, 2].mean()])
+        rel = points.reshape(-1, 3) - origin  # moments about the centroid, for conditioning
         e = edges.reshape(-1, 3)
         r = np.repeat(rel, edges.shape[1], axis=0)
-        a_eq = np.zeros((6, n_lam + 2))
+        a_eq = np.zeros((6, n + 2))
         a_eq[:3, :n_lam] = e.T  # Σf = m g ẑ, forces in body weights
-        a_eq[3:, :n_lam] = np.cross(r, e).T  # Σ r×f + (c − o)×(−m g ẑ) = 0
-        a_eq[3, n_lam + 1] = -1.0  # x row: −(c_y − o_y)
-        a_eq[4, n_lam] = 1.0  # y row: +(c_x − o_x)
-        self.a_eq = a_eq
+        a_eq[3:, :n_lam] = np.cross(r, e).T  # Σ r×f + Σ t + (c − o)×(−m g ẑ) = 0
+        a_ub, b_ub = np.zeros((0, n + 2)), np.zeros(0)
+        for i, (p, rows, rhs) in enumerate(grips):
+            cols = slice(n_lam + 12 * i, n_lam + 12 * (i + 1))
+            a_eq[:, cols] = _split_wrench_basis(p - origin)
+            block = np.zeros((len(rows), n + 2))
+            block[:, cols] = rows
+            a_ub, b_ub = np.vstack([a_ub, block]), np.concatenate([b_ub, rhs])
+        a_eq[3, n + 1] = -1.0  # x row: −(c_y − o_y)
+        a_eq[4, n] = 1.0  # y row: +(c_x − o_x)
+        self.a_eq, self.a_ub, self.b_ub = a_eq, a_ub, b_ub
         self.b_eq = np.array([0.0, 0.0, 1.0, 0.0, 0.0, 0.0])
-        self.bounds = np.zeros((n_lam + 2, 2))
+        self.bounds = np.zeros((n + 2, 2))
         self.bounds[:n_lam, 1] = np.inf
-        self.bounds[n_lam:, 0] = -box_half_m
-        self.bounds[n_lam:, 1] = box_half_m
+        self.bounds[n_lam:n, 1] = wrench_max
+        self.bounds[n:, 0] = -box_half_m
+        self.bounds[n:, 1] = box_half_m
         self.box_half_m = box_half_m
-        self.n_lam = n_lam
+        self.n_lam = n
         self.count = 0
 
     def solve(self, d: np.ndarray) -> np.ndarray | None:
@@ -287,7 +346,9 @@ class _ProjectionLP:
         cost = np.zeros(self.n_lam + 2)
         cost[self.n_lam:] = -d
         self.count += 1
-        res = linprog(cost, A_eq=self.a_eq, b_eq=self.b_eq, bounds=self.bounds, method="highs")
+        ub = {} if not len(self.b_ub) else {"A_ub": self.a_ub, "b_ub": self.b_ub}
+        res = linprog(cost, A_eq=self.a_eq, b_eq=self.b_eq, bounds=self.bounds, method="highs",
+                      **ub)
         if res.status == 2:
             return None
         if res.status != 0:
@@ -305,11 +366,12 @@ def support_region(stance: Stance, mass_kg: float, g: float = GRAVITY_M_S2, *,
     the inner-polygon edge with the largest gap to the outer polygon (the support lines),
     until the gap is below ``max(area_tol_m2, area_rel_tol × area)`` or every edge is
     exact. With pure friction cones the region does not depend on mass or g (both scale
-    the forces only); they are kept in the signature for force-limited contacts.
+    the forces only); a grip's limits (a hand hold with ``limits``) are forces, and with
+    them it does.
 
-    Contacts that can pull (a gripping hand) can make the region unbounded; the LP caps
-    c_xy to a square of half-side ``config.box_half_m`` around the contacts' centroid, and
-    the result is then flagged ``clipped``.
+    Contacts that can pull (a hand hold without limits) can make the region unbounded; the
+    LP caps c_xy to a square of half-side ``config.box_half_m`` around the contacts'
+    centroid, and the result is then flagged ``clipped``.
 
     Args:
         stance: the holds; ``stance.points_normals()`` gives the contacts.
@@ -323,9 +385,18 @@ def support_region(stance: Stance, mass_kg: float, g: float = GRAVITY_M_S2, *,
     cfg = config or default_config()
     if mass_kg <= 0 or g <= 0:
         raise ValueError(f"mass_kg and g must be positive, got {mass_kg}, {g}")
-    points, normals, mu = stance.points_normals()
-    lp = _ProjectionLP(np.asarray(points, float), friction_cone_edges(normals, mu, cfg.cone_edges),
-                       cfg.box_half_m)
+    cones, grip_holds = _cone_and_grip_holds(stance)
+    weight_n = mass_kg * g
+    points = np.vstack([h.points_m for h in cones]) if cones else np.zeros((0, 3))
+    normals = np.vstack([h.normals for h in cones]) if cones else np.zeros((0, 3))
+    mu = np.concatenate([np.full(len(h.points_m), h.friction) for h in cones]) if cones \
+        else np.zeros(0)
+    edges = friction_cone_edges(normals, mu, cfg.cone_edges) if cones \
+        else np.zeros((0, cfg.cone_edges, 3))
+    grips = tuple((h.T_world_frame[:3, 3], *_grip_rows(h.limits, weight_n))
+                  for h in grip_holds)
+    lp = _ProjectionLP(np.asarray(points, float), edges, cfg.box_half_m, grips,
+                       cfg.force_max_weights)
 
     # Initial probes, counter-clockwise; consecutive equal points are merged, keeping the
     # range of directions [d_in, d_out] each vertex is known to be optimal for.
@@ -486,13 +557,26 @@ class TorqueCheck:
     """Result of `torque_feasibility`.
 
     Attributes:
-        feasible: the equilibrium LP is feasible and ``max_ratio <= 1``.
-        equilibrium: contact forces in the cones can balance gravity (free-flyer rows).
-        max_ratio: min over contact forces of max_j |τ_j| / τmax_j (inf if no equilibrium).
+        feasible: the equilibrium LP is feasible and ``max_ratio <= 1`` (and, for the
+            ``contact`` objective, every grip within its limits).
+        equilibrium: contact wrenches within the contacts' limits can balance gravity
+            (free-flyer rows; with the ``contact`` objective, with the joints within
+            their limits too).
+        max_ratio: max_j |τ_j| / τmax_j of the solution (the minimum over contact
+            wrenches for the ``torque`` objective; inf if no equilibrium).
         worst_joint: joint reaching ``max_ratio`` ("" if no equilibrium).
-        forces_n: per limb, (k, 3) world-frame forces on the robot at the hold's points [N].
+        forces_n: per limb, (k, 3) world-frame forces on the robot at the hold's points
+            [N]; a grip's is (1, 3), at its palm frame.
         joint_names: actuated joints, in pinocchio velocity order.
         torques_nm: (len(joint_names),) joint torques holding the configuration [N·m].
+        wrenches: per limb, the (force [N], torque [N·m]) the hold applies to the robot
+            about its limb frame's origin (palm or sole), world frame.
+        contact_use: per limb whose hold has limits, each limit's use: a grip's
+            `ladders.contact_model.GRIP_LOADS` as shares of its whole capacity, a foot's
+            friction and centre of pressure (`ladders.contact_model.FootPatch.utilisation`).
+        objective: what the LP minimised (`OBJECTIVES`).
+        grip_share: for the ``contact`` objective, the LP's bound on the grips' use
+            (≥ every grip's linearised use).
     """
 
     feasible: bool
@@ -502,10 +586,27 @@ class TorqueCheck:
     forces_n: dict[str, np.ndarray] = field(default_factory=dict, repr=False)
     joint_names: tuple[str, ...] = field(default=(), repr=False)
     torques_nm: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
+    wrenches: dict[str, tuple[np.ndarray, np.ndarray]] = field(default_factory=dict,
+                                                               repr=False)
+    contact_use: dict[str, dict[str, float]] = field(default_factory=dict, repr=False)
+    objective: str = "torque"
+    grip_share: float = math.nan
 
     def torque(self, joint: str) -> float:
         """Torque of one joint [N·m]."""
         return float(self.torques_nm[self.joint_names.index(joint)])
+
+    def worst_contact(self, hands_only: bool = False) -> tuple[str, str, float]:
+        """(limb, limit, use) of the most used contact limit (of the grips only, if
+        ``hands_only``); ("", "", 0) if none."""
+        best = ("", "", 0.0)
+        for limb, use in self.contact_use.items():
+            if hands_only and not limb.endswith("hand"):
+                continue
+            for load, u in use.items():
+                if u > best[2]:
+                    best = (limb, load, u)
+        return best
 
     def __repr__(self) -> str:
         if not self.equilibrium:
@@ -513,8 +614,10 @@ class TorqueCheck:
         loads = ", ".join(f"{limb} {np.linalg.norm(f.sum(axis=0)):.0f} N"
                           for limb, f in self.forces_n.items())
         verdict = "feasible" if self.feasible else "INFEASIBLE"
+        limb, load, use = self.worst_contact()
+        grip = f"; {limb} {load} {use:.2f} of its limit" if limb else ""
         return (f"TorqueCheck({verdict}, max |τ|/τmax = {self.max_ratio:.3f} at "
-                f"{self.worst_joint}, {self.torque(self.worst_joint):+.1f} N·m; {loads})")
+                f"{self.worst_joint}, {self.torque(self.worst_joint):+.1f} N·m; {loads}{grip})")
 
 
 #: `_actuated` per model and limits: (model, result), keyed by the model's id and the
@@ -573,19 +676,25 @@ def _walk_actuated(model, torque_max_nm_by_joint: Mapping[str, float]):
 def torque_feasibility(model, data, q: np.ndarray, stance: Stance,
                        torque_max_nm_by_joint: Mapping[str, float],
                        frame_ids: Mapping[str, int] | None = None, *,
-                       config: StabilityConfig | None = None) -> TorqueCheck:
+                       config: StabilityConfig | None = None,
+                       objective: str = "torque") -> TorqueCheck:
     """Can the joints hold configuration q on the stance's contacts? (one LP)
 
-    Static equilibrium g(q) = Sᵀτ + Σ J_pᵀ f: the free-flyer rows (first 6) are met
-    exactly by contact forces f in the linearised cones, and the LP minimises
-    t = max_j |τ_j| / τmax_j over the actuated joints (epigraph form).
+    Static equilibrium g(q) = Sᵀτ + Σ Jᵀ w: the free-flyer rows (first 6) are met exactly
+    by contact wrenches w, each inside its contact's limits: point forces in the
+    linearised cones at a hold's points, or for a hold with grip limits
+    (`ladders.contact_model.HandLimits`) a 6-D wrench about its limb frame inside the
+    grip's halfspaces. With ``objective="torque"`` the LP minimises t = max_j |τ_j| /
+    τmax_j over the actuated joints (epigraph form), plus `GRIP_LOAD_COST` per unit of
+    grip use; with ``"contact"`` it keeps every |τ_j| ≤ τmax_j and minimises s, the
+    share of their halfspaces' bounds the grips use (check-plan's contact-wrench check).
 
     Each hold's contact points are rigidly attached to its limb frame: their offsets in
     the frame are taken from the hold (``inv(T_world_frame) @ p``) and placed with the
     frame's pose at q, so a configuration that misses its hold slightly still gets the
     right lever arms. Normals, and therefore friction cones, stay those of the hold
-    (world frame). The point Jacobian is the frame's LOCAL_WORLD_ALIGNED Jacobian shifted
-    to the point, so J_pᵀ f = J_vᵀ f + J_ωᵀ (r × f).
+    (world frame), as does a grip's rail axis. The point Jacobian is the frame's
+    LOCAL_WORLD_ALIGNED Jacobian shifted to the point, so J_pᵀ f = J_vᵀ f + J_ωᵀ (r × f).
 
     Args:
         model: pinocchio model with a free-flyer root (gravity from ``model.gravity``).
@@ -596,12 +705,15 @@ def torque_feasibility(model, data, q: np.ndarray, stance: Stance,
             name [N·m] (see `torque_limits_by_joint`).
         frame_ids: frame id per limb; looked up from ``LIMB_FRAME`` if None.
         config: tunables, `default_config()` if None.
+        objective: one of `OBJECTIVES`.
 
     Returns:
         The check; ``feasible`` iff the equilibrium is feasible and max ratio ≤ 1.
     """
     import pinocchio as pin
 
+    if objective not in OBJECTIVES:
+        raise ValueError(f"unknown objective {objective!r}; use one of {OBJECTIVES}")
     cfg = config or default_config()
     names, v_idx, tmax, weight_n = _actuated(model, torque_max_nm_by_joint)
 
@@ -609,7 +721,7 @@ def torque_feasibility(model, data, q: np.ndarray, stance: Stance,
     pin.updateFramePlacements(model, data)
     grav = pin.computeGeneralizedGravity(model, data, q) / weight_n
 
-    cols, edges_by_hold = [], []
+    cols, parts, grip_rows, cost_parts = [], [], [], []
     for hold in stance.holds:
         if frame_ids is not None and hold.limb in frame_ids:
             fid = frame_ids[hold.limb]
@@ -619,6 +731,16 @@ def torque_feasibility(model, data, q: np.ndarray, stance: Stance,
                 raise HuboLadderError(f"frame {fname!r} of {hold.limb} is not in the model")
             fid = model.getFrameId(fname)
         o_m_f = data.oMf[fid]
+        jac = pin.getFrameJacobian(model, data, fid, pin.LOCAL_WORLD_ALIGNED)
+        if isinstance(hold.limits, HandLimits):
+            cols.append(jac.T @ _split_wrench_basis(np.zeros(3)))  # (nv, 12)
+            rows, rhs = _grip_rows(hold.limits, weight_n)
+            grip_rows.append((len(parts), rows, rhs))
+            cap = hold.limits.capacity
+            per = np.array([cap.radial_n] * 3 + [cap.bending_nm] * 3)
+            cost_parts.append(np.tile(GRIP_LOAD_COST * weight_n / per, 2))
+            parts.append((hold, o_m_f.rotation.copy(), None, None))
+            continue
         t_inv = np.linalg.inv(hold.T_world_frame)
         pts_local = hold.points_m @ t_inv[:3, :3].T + t_inv[:3, 3]
         r = pts_local @ o_m_f.rotation.T  # world-frame offsets from the frame origin [m]
@@ -627,42 +749,77 @@ def torque_feasibility(model, data, q: np.ndarray, stance: Stance,
         k = e.shape[1]
         e_flat = e.reshape(-1, 3)
         wrench = np.vstack([e_flat.T, _cross_rows(np.repeat(r, k, axis=0), e_flat).T])
-        jac = pin.getFrameJacobian(model, data, fid, pin.LOCAL_WORLD_ALIGNED)
         cols.append(jac.T @ wrench)  # (nv, m k), per unit weight
-        edges_by_hold.append((hold.limb, e))
+        cost_parts.append(np.zeros(e_flat.shape[0]))
+        parts.append((hold, o_m_f.rotation.copy(), e, r))
     gmat = np.hstack(cols)
-    n_lam = gmat.shape[1]
+    n_c = gmat.shape[1]
+    starts = np.concatenate([[0], np.cumsum([c.shape[1] for c in cols])])
 
-    # Variables [λ (body weights), t]. τ/W = g_a/W − G_a λ; |τ_j| ≤ t τmax_j.
+    # Variables [contacts (body weights), t or s]. τ/W = g_a/W − G_a x.
     g_a, gm_a = grav[v_idx], gmat[v_idx]
     tm = (tmax / weight_n)[:, None]
-    a_ub = np.block([[gm_a, -tm], [-gm_a, -tm]])
-    b_ub = np.concatenate([g_a, -g_a])
+    if objective == "torque":  # |τ_j| ≤ t τmax_j; grips A y ≤ b
+        a_ub = np.block([[gm_a, -tm], [-gm_a, -tm]])
+        b_ub = np.concatenate([g_a, -g_a])
+    else:  # |τ_j| ≤ τmax_j; grips A y ≤ s b
+        a_ub = np.block([[gm_a, np.zeros_like(tm)], [-gm_a, np.zeros_like(tm)]])
+        b_ub = np.concatenate([g_a + tm[:, 0], -g_a + tm[:, 0]])
+    for i, rows, rhs in grip_rows:
+        block = np.zeros((len(rows), n_c + 1))
+        block[:, starts[i]:starts[i + 1]] = rows
+        if objective == "torque":
+            b_ub = np.concatenate([b_ub, rhs])
+        else:
+            block[:, n_c] = -rhs
+            b_ub = np.concatenate([b_ub, np.zeros(len(rhs))])
+        a_ub = np.vstack([a_ub, block])
     a_eq = np.hstack([gmat[:6], np.zeros((6, 1))])
     b_eq = grav[:6]
-    upper = np.full(n_lam + 1, cfg.force_max_weights)
-    upper[n_lam] = np.inf
-    cost = np.zeros(n_lam + 1)
-    cost[-1] = 1.0
+    upper = np.full(n_c + 1, cfg.force_max_weights)
+    upper[n_c] = np.inf
+    cost = np.concatenate(cost_parts + [[1.0]])
     status, x = _solve_min_max_lp(cost, a_ub, b_ub, a_eq, b_eq, upper)
     if status == "infeasible":
-        return TorqueCheck(False, False, math.inf, "", joint_names=names)
+        return TorqueCheck(False, False, math.inf, "", joint_names=names, objective=objective)
     if status != "optimal":
         raise StabilityError(f"torque LP failed for {stance!r}: HiGHS status {status}")
 
-    lam = x[:n_lam]
-    tau = (g_a - gm_a @ lam) * weight_n
+    tau = (g_a - gm_a @ x[:n_c]) * weight_n
     ratios = np.abs(tau) / tmax
     worst = int(np.argmax(ratios))
-    forces, start = {}, 0
-    for limb, e in edges_by_hold:
-        m, k = e.shape[:2]
-        lam_h = lam[start:start + m * k].reshape(m, k)
-        forces[limb] = np.einsum("mk,mki->mi", lam_h, e) * weight_n
-        start += m * k
+    forces, wrenches, use = {}, {}, {}
+    for i, (hold, rot, e, r) in enumerate(parts):
+        xi = x[starts[i]:starts[i + 1]]
+        if e is None:  # a grip: its split wrench
+            w = (xi[:6] - xi[6:]) * weight_n
+            force, torque = w[:3], w[3:]
+            forces[hold.limb] = force[None, :]
+            use[hold.limb] = hold.limits.utilisation(force, torque)
+        else:
+            m, k = e.shape[:2]
+            f = np.einsum("mk,mki->mi", xi.reshape(m, k), e) * weight_n
+            forces[hold.limb] = f
+            force, torque = f.sum(axis=0), _cross_rows(r, f).sum(axis=0)
+            if isinstance(hold.limits, FootPatch):
+                use[hold.limb] = _foot_use(hold.limits, rot, force, torque)
+        wrenches[hold.limb] = (force, torque)
     max_ratio = float(ratios[worst])
-    return TorqueCheck(max_ratio <= 1.0 + 1e-9, True, max_ratio, names[worst], forces,
-                       names, tau)
+    share = float(x[n_c]) if objective == "contact" else math.nan
+    feasible = max_ratio <= 1.0 + 1e-9 and (objective == "torque" or share <= 1.0 + 1e-9)
+    return TorqueCheck(feasible, True, max_ratio, names[worst], forces, names, tau,
+                       wrenches, use, objective, share)
+
+
+def _foot_use(patch: FootPatch, R_world_sole: np.ndarray, force: np.ndarray,
+              torque: np.ndarray) -> dict[str, float]:
+    """A sole's friction and centre-of-pressure use of its patch, from its wrench about
+    the sole frame's origin (world frame)."""
+    f_l, t_l = R_world_sole.T @ force, R_world_sole.T @ torque
+    fz = float(f_l[2])
+    if fz <= 1e-6:  # an unloaded sole: no friction, no centre of pressure to place
+        return dict.fromkeys(patch.utilisation(np.array([0.0, 0.0, 1.0]), np.zeros(2)), 0.0)
+    return patch.utilisation(f_l, np.array([-t_l[1] / fz, t_l[0] / fz]))
 
 
 # --------------------------------------------------------------------------------------

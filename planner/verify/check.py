@@ -18,7 +18,16 @@ ladder's orientation on a rung, level on the floor), then checks:
   (friction cones, Bretl–Lall) of the holds that may balance it (a lone compliant hand
   may not, `planner.statics.arm_capacity.balance_stance`) and the joint torques within limits
   (LP), an arm whose hand holds a rail limited to what the sidecar's arm strategy lets it
-  give.
+  give;
+- contact wrenches: every grip's wrench in the torque LP's load share inside its limits
+  (`ladders.contact_model`: radial force, bending, friction along and about the rail),
+  the worst hold and limit named; a foot's friction cone and patch are the LP's
+  constraints. Where the torque LP finds no share within the joint limits, a second
+  LP reports the least use of the grips' capacity any such share needs.
+
+The contacts are the contact model's, whole: the grip's full capacity (the planner keeps
+`ladders.contact_model.GRIP_RESERVE` of it), the spec's μ and the sole's whole patch on
+its tread (the planner keeps a friction share and a centre-of-pressure margin).
 
 `check_plan` returns, per check, the worst line and whether any line fails.
 """
@@ -34,16 +43,18 @@ from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
-from planner.holds import half_tread_m, sole_contact_points
+from ladders.contact_model import hand_limits, sole_patch_x
+from planner.holds import foot_patch, half_tread_m
 from planner.statics.arm_capacity import balance_stance, gripping_sides, gripping_torque_limits
 from robot.errors import InputError
 from robot.plan_sidecar import PlanSidecar, Segment
 
 if TYPE_CHECKING:
-    from planner.contacts import Stance
+    from planner.contacts import Hold, Stance
     from planner.statics.stability import SupportRegion, TorqueCheck
 
-__all__ = ["CHECKS", "CheckResult", "HOLD_TOL_M", "PlannedLoad", "allowed_contacts", "check_plan",
+__all__ = ["CHECKS", "CheckResult", "ContactLoad", "HOLD_TOL_M", "PlannedLoad",
+           "allowed_contacts", "check_plan", "contact_hold", "contact_wrench_utilisation",
            "planned_loads"]
 
 log = logging.getLogger(__name__)
@@ -55,7 +66,7 @@ LIMIT_TOL_RAD = 1e-9
 #: Clearance (a slow distance query) is measured on every this-many-th line.
 CLEARANCE_EVERY_LINES = 20
 CHECKS = ("joint limits", "velocity", "holds", "collision", "stability margin",
-          "torque ratio")
+          "torque ratio", "contact wrench")
 _FRAME = {"left_hand": "L_palm", "right_hand": "R_palm", "left_foot": "L_sole",
           "right_foot": "R_sole"}
 
@@ -120,6 +131,80 @@ def allowed_contacts(segments: Sequence[Segment], index: int, fraction: float
         if choice is not None:
             contacts[limb] = choice
     return contacts
+
+
+def contact_hold(spec, geom, params, limb: str, record) -> Hold:
+    """The contact model of a recorded hold (`ladders.contact_model`, whole): a grip with
+    its full capacity on the rail, or the sole's whole patch on its tread (the overlap; a
+    line on a round rung) at the spec's μ.
+
+    Args:
+        spec, geom: the ladder and its `ladders.geometry.LadderGeometry`.
+        params: the robot's `robot.params.RobotParams`.
+        limb: the held limb.
+        record: the sidecar's `robot.plan_sidecar.HoldRecord`.
+    """
+    from planner.contacts import Hold
+
+    p = np.asarray(record.position_m, dtype=float)
+    mu = spec.friction
+    up = np.array([0.0, 0.0, 1.0])
+    T = np.eye(4)
+    T[:3, 3] = p
+    if limb.endswith("hand"):
+        towards = geom.R_world_ladder[:, 0]
+        return Hold(limb, record.target, T, np.vstack([p, p]), np.vstack([up, towards]), mu,
+                    limits=hand_limits(mu, spec.rail_radius_m, geom.ladder_direction))
+    R = np.eye(3) if record.target == "floor" else geom.R_world_ladder
+    T[:3, :3] = R
+    hl = params.foot_length_m / 2
+    x_range = (-hl, hl)
+    if record.target.startswith("rung_"):
+        top = geom.rung_top_centres_m[int(record.target.removeprefix("rung_"))]
+        # Tread centre along the sole's x axis, relative to the sole frame.
+        c = float(R[:, 0] @ (top - p))
+        x_range = sole_patch_x(spec.rung_shape, half_tread_m(spec), c, params.foot_length_m)
+        if x_range is None:  # the sole misses its rung: a line at the nearest sole edge
+            c = float(np.clip(c, -hl, hl))
+            x_range = (c, c)
+    # The whole patch: check-plan verifies the physics, not the planner's margin.
+    patch = foot_patch(params, x_range, mu, margin_m=0.0)
+    pts = patch.corners() @ R.T + p
+    return Hold(limb, record.target, T, pts, np.tile(up, (4, 1)), mu, limits=patch)
+
+
+class ContactLoad(NamedTuple):
+    """check-plan's contact-wrench account of one line.
+
+    Attributes:
+        value: the worst use of a contact limit [share of it] (inf: no load share within
+            the joint limits keeps the holds within theirs).
+        limb: the hold that reaches it ("" if none).
+        load: which of its limits.
+        detail: one clause for the report.
+    """
+
+    value: float
+    limb: str
+    load: str
+    detail: str
+
+
+def contact_wrench_utilisation(check: TorqueCheck) -> ContactLoad:
+    """The most used grip limit of a torque LP's solution
+    (`planner.statics.stability.torque_feasibility`). A foot's limits are the LP's own
+    constraints (cones at the spec's μ at its patch's corners), which its solution meets
+    with equality wherever a vertex lies: an overloaded foot shows as no equilibrium."""
+    if not check.equilibrium:
+        return ContactLoad(math.inf, "", "", "no load share within the joint limits keeps "
+                           "every hold within its contact limits")
+    limb, load, use = check.worst_contact(hands_only=True)
+    if not limb:
+        return ContactLoad(0.0, "", "", "no grip")
+    force, torque = check.wrenches[limb]
+    return ContactLoad(use, limb, load, f"{limb} {load} {use:.2f} of its limit "
+                       f"(|F| = {np.linalg.norm(force):.0f} N, |T| = "
+                       f"{np.linalg.norm(torque):.1f} N·m)")
 
 
 class _SegmentStance(NamedTuple):
@@ -211,34 +296,9 @@ class _Verifier:
         return self.data.oMf[self.frame_id[limb]].translation.copy()
 
     # ---------------------------------------------------------------- stability
-    def contact_hold(self, limb: str, record) -> object:
-        """The contact model of a recorded hold (sole corners on the tread, or a palm
-        pushing up and pulling towards the ladder)."""
-        from planner.contacts import Hold
-
-        p = np.asarray(record.position_m, dtype=float)
-        mu = self.spec.friction
-        up = np.array([0.0, 0.0, 1.0])
-        T = np.eye(4)
-        T[:3, 3] = p
-        if limb.endswith("hand"):
-            towards = self.geom.R_world_ladder[:, 0]
-            return Hold(limb, record.target, T, np.vstack([p, p]), np.vstack([up, towards]), mu)
-        R = self.sole_rotation(record.target)
-        T[:3, :3] = R
-        hl = self.params.foot_length_m / 2
-        x0, x1 = -hl, hl
-        if record.target.startswith("rung_"):
-            top = self.geom.rung_top_centres_m[int(record.target.removeprefix("rung_"))]
-            # Tread centre along the sole's x axis, relative to the sole frame.
-            c = float(R[:, 0] @ (top - p))
-            half = half_tread_m(self.spec)
-            x0, x1 = max(-hl, c - half), min(hl, c + half)
-            if x1 <= x0:
-                x0 = x1 = float(np.clip(c, -hl, hl))
-        # The whole support: check-plan verifies the physics, not the planner's margin.
-        pts = sole_contact_points(self.params, T, (x0, x1), margin_m=0.0)
-        return Hold(limb, record.target, T, pts, np.tile(up, (4, 1)), mu)
+    def contact_hold(self, limb: str, record) -> Hold:
+        """The contact model of a recorded hold (`contact_hold`)."""
+        return contact_hold(self.spec, self.geom, self.params, limb, record)
 
     def stance(self, seg_index: int, seg: Segment) -> _SegmentStance:
         """The stance of a segment, its support region and its joint torque limits [N·m]
@@ -334,7 +394,7 @@ def check_plan(traj_rad: np.ndarray, sidecar: PlanSidecar, spec, robot: str | No
     Raises:
         InputError: the sidecar and the trajectory disagree (line count, coverage).
     """
-    from planner.statics.stability import check_stability
+    from planner.statics.stability import check_stability, torque_feasibility
     from robot.joints import JOINT_NAMES
     from robot.limits import joint_limits
 
@@ -358,6 +418,7 @@ def check_plan(traj_rad: np.ndarray, sidecar: PlanSidecar, spec, robot: str | No
     res["collision"].limit, res["collision"].unit = 0.0, "m clearance"
     res["stability margin"].limit, res["stability margin"].unit = 0.0, "m"
     res["torque ratio"].limit, res["torque ratio"].unit = 1.0, "× limit"
+    res["contact wrench"].limit, res["contact wrench"].unit = 1.0, "× limit"
 
     # Joint limits and speeds: whole-array checks.
     beyond = np.maximum(lim.lower_rad - traj_rad, traj_rad - lim.upper_rad)
@@ -424,11 +485,18 @@ def check_plan(traj_rad: np.ndarray, sidecar: PlanSidecar, spec, robot: str | No
             rep_s = check_stability(v.model, v.data, q, held.stance, held.region,
                                     held.torque_limits)
             tq = rep_s.torque
+            contact = None
+            if tq is not None and tq.feasible:  # the torque LP's own wrenches
+                contact = contact_wrench_utilisation(tq)
+            elif tq is not None:  # the least contact use any share within the joints needs
+                contact = contact_wrench_utilisation(torque_feasibility(
+                    v.model, v.data, q, held.stance, held.torque_limits, v.frame_id,
+                    objective="contact"))
             out = (hit, clear, pair, rep_s.margin_m,
                    math.inf if tq is None else tq.max_ratio, "" if tq is None else tq.worst_joint,
-                   tq is not None and tq.feasible)
+                   tq is not None and tq.feasible, contact)
             prev_key, prev_out = key, out
-        hit, clear, pair, margin, ratio_t, joint, feasible = out
+        hit, clear, pair, margin, ratio_t, joint, feasible, contact = out
         if hit or not math.isnan(clear):
             d = clear if not math.isnan(clear) else 0.0
             res["collision"].offer(line, -d + (1.0 if hit else 0.0), d,
@@ -441,4 +509,7 @@ def check_plan(traj_rad: np.ndarray, sidecar: PlanSidecar, spec, robot: str | No
         if margin >= 0.0:
             res["torque ratio"].offer(line, ratio_t, ratio_t, f"{label}: worst joint {joint}",
                                       not feasible)
+        if contact is not None:
+            res["contact wrench"].offer(line, contact.value, contact.value,
+                                        f"{label}: {contact.detail}", contact.value > 1.0 + 1e-6)
     return [res[c] for c in CHECKS]
