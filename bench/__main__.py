@@ -1,6 +1,6 @@
 """``make bench``: run every benchmark and print its figures against the targets.
 
-Usage: ``python -m bench [--only planner,sim,daemon,channels,can,batch] [--json FILE]``.
+Usage: ``python -m bench [--only planner,sim,tracking,daemon,channels,can,batch] [--json FILE]``.
 Figures are measurements on this machine; a target missed is shown, not hidden.
 """
 
@@ -12,7 +12,7 @@ import json
 import sys
 import time
 
-SUITES = ("planner", "sim", "daemon", "channels", "can", "batch")
+SUITES = ("planner", "sim", "tracking", "daemon", "channels", "can", "batch")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -44,7 +44,8 @@ def main(argv: list[str] | None = None) -> int:
         table.add_column(col)
     for f in figures:
         target = "" if f.get("target") is None else str(f["target"])
-        met = "—" if f.get("target") is None else ("yes" if f.get("ok") else "[red]NO[/]")
+        met = "—" if f.get("target") is None or f.get("ok", False) is None else (
+            "yes" if f.get("ok") else "[red]NO[/]")
         table.add_row(f["suite"], f["name"], str(f["value"]), f.get("unit", ""), target, met)
     console.print(table)
     if args.json:

@@ -35,6 +35,7 @@ SMALL = JobFunctions(plan=small.small_plan, validate=small.small_validate)
     (["--time-limit", "-1"], ["--time-limit is -1", "> 0 s"]),
     (["--strategies", "mixed,hover"], ["--strategies", "hover", "mixed, position, pwm"]),
     (["--strategies", "pwm,pwm"], ["--strategies", "pwm given twice"]),
+    (["--loop", "closed,sideways"], ["--loop", "closed, open or closed,open"]),
     (["--ladders", "drc,tower"], ["--ladders", "unknown ladder 'tower'"]),
     (["--perturb", "placement=3"], ["--perturb placement=3", "(0, 1] m"]),
     (["--perturb", "wind=3"], ["wind=3", "placement, yaw, rung, friction, battery"]),
@@ -79,7 +80,7 @@ def test_small_run_prints_and_writes_tables_and_plots(tmp_path):
     assert "success rate per ladder × strategy" in text and "planning per ladder" in text
     rows = list(csv.DictReader((out / "summary.csv").open()))
     assert [(r["ladder"], r["strategy"]) for r in rows] == [
-        (lad, s) for lad in ("drc", "stair") for s in ("mixed", "position", "pwm")]
+        (lad, f"{s} closed") for lad in ("drc", "stair") for s in ("mixed", "position", "pwm")]
     for r in rows:
         assert int(r["runs"]) == 8 and int(r["errors"]) == 0 and int(r["missing"]) == 0
         assert float(r["ci95_low"]) <= float(r["rate"] or 0) <= float(r["ci95_high"])
@@ -89,6 +90,22 @@ def test_small_run_prints_and_writes_tables_and_plots(tmp_path):
         assert (out / "plots" / f"{name}.png").stat().st_size > 5000
     records = [json.loads(x) for x in (out / RESULTS_FILE).read_text().splitlines()]
     assert len(records) == 2 * 4 + 2 * 4 * 3 * 2
+
+
+def test_loop_axis_pairs_open_and_closed_runs_on_the_same_draws(tmp_path):
+    out = tmp_path / "o"
+    code, _text = _run_small(["--ladders", "drc", "--seeds", "2", "--strategies", "mixed",
+                              "--loop", "closed,open", "--perturb", "placement=0.03",
+                              "--workers", "1", "--out", str(out)])
+    assert code == 0
+    rows = list(csv.DictReader((out / "summary.csv").open()))
+    assert [r["strategy"] for r in rows] == ["mixed closed", "mixed open"]
+    records = [json.loads(x) for x in (out / RESULTS_FILE).read_text().splitlines()]
+    runs = [r for r in records if r["kind"] == "validate"]
+    assert sorted(r["loop"] for r in runs) == ["closed", "closed", "open", "open"]
+    for seed in (1, 2):
+        pair = [r["perturbation"] for r in runs if r["seed"] == seed]
+        assert len(pair) == 2 and pair[0] == pair[1]
 
 
 def test_small_sweep_run_writes_a_heat_map(tmp_path):

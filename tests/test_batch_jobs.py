@@ -45,7 +45,7 @@ def test_expansion_counts_keys_and_dependencies():
     keys = [j.key for j in [*plans, *vals]]
     assert len(set(keys)) == len(keys)
     assert {v.plan for v in vals} == set(plans)
-    assert "validate/stair/s2/pwm/d1" in keys and "plan/drc/s3" in keys
+    assert "validate/stair/s2/pwm/closed/d1" in keys and "plan/drc/s3" in keys
     # fingerprints follow the inputs: same job, same print; other settings, other print
     again, _ = expand_jobs(_ladders("drc"), [1], STRATS, PERTURB)
     assert again[0].fingerprint == plans[0].fingerprint
@@ -238,17 +238,17 @@ def test_raising_and_crashing_jobs_are_recorded_and_the_run_goes_on(tmp_path, en
     by_key = {r["key"]: r for r in run.records}
     assert len(by_key) == len(plans) + len(vals)
 
-    raised = by_key[f"validate/drc/s{small.RAISE_VALIDATE_SEED}/position/d0"]
+    raised = by_key[f"validate/drc/s{small.RAISE_VALIDATE_SEED}/position/closed/d0"]
     assert raised["status"] == "error" and raised["error"].startswith("ValueError: simulation")
     assert "small_validate" in raised["traceback"]
 
-    crashed = by_key[f"validate/drc/s{small.CRASH_SEED}/pwm/d0"]
+    crashed = by_key[f"validate/drc/s{small.CRASH_SEED}/pwm/closed/d0"]
     assert crashed["status"] == "error" and "BrokenProcessPool" in crashed["error"]
     # its neighbours were re-run, not blamed
-    assert by_key[f"validate/drc/s{small.CRASH_SEED}/mixed/d0"]["status"] == "ok"
+    assert by_key[f"validate/drc/s{small.CRASH_SEED}/mixed/closed/d0"]["status"] == "ok"
 
     assert by_key[f"plan/drc/s{small.RAISE_PLAN_SEED}"]["error"].startswith("RuntimeError")
-    dep = by_key[f"validate/drc/s{small.RAISE_PLAN_SEED}/mixed/d0"]
+    dep = by_key[f"validate/drc/s{small.RAISE_PLAN_SEED}/mixed/closed/d0"]
     assert dep["status"] == "error" and "its plan job" in dep["error"]
 
     errors = {r["key"] for r in run.errors}

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import ast
 import dataclasses
+import json
 import sys
 from pathlib import Path
 
@@ -79,10 +80,13 @@ def test_the_estimator_runs_on_the_state_struct_alone():
     assert est.finger_curl_rad["left"] == pytest.approx(0.09)
     assert np.allclose(est.R_tilt, np.eye(3))
     s = SensedState.from_sample(sample)
-    assert read_grasp("left", s.pos_rad, s.vel_rad_s) is GraspReading.ON_RAIL
+    assert read_grasp("left", s.pos_rad, s.vel_rad_s, 0.025) is GraspReading.ON_RAIL
     sample["pos"][fingers] = FINGER_CLOSED_RAD
     s = SensedState.from_sample(sample)
-    assert read_grasp("left", s.pos_rad, s.vel_rad_s) is GraspReading.EMPTY
+    assert read_grasp("left", s.pos_rad, s.vel_rad_s, 0.025) is GraspReading.EMPTY
+    sample["pos"][fingers] = 0.0  # fingers that never closed do not hold a rail
+    s = SensedState.from_sample(sample)
+    assert read_grasp("left", s.pos_rad, s.vel_rad_s, 0.025) is GraspReading.CLOSING
     with pytest.raises(TypeError):
         SensedState.from_sample(np.zeros(3))
 
@@ -195,3 +199,17 @@ def test_an_unrecoverable_miss_holds_with_no_weight_shift(reach, tmp_path):
     code = validate_main([str(path), "--placement-error", "0.115,0,0",
                           "--json", str(tmp_path / "r.json")])
     assert code == 1
+
+
+def test_validate_plan_reports_the_loop_and_what_the_layer_did(reach, tmp_path, capsys):
+    path = reach[0]
+    closed, opened = tmp_path / "closed.json", tmp_path / "open.json"
+    assert validate_main([str(path), "--json", str(closed)]) == 0
+    out = capsys.readouterr().out
+    assert "motion layer: 2 grasp verified" in out
+    assert validate_main([str(path), "--open-loop", "--json", str(opened)]) == 0
+    c, o = json.loads(closed.read_text()), json.loads(opened.read_text())
+    assert (c["loop"], o["loop"]) == ("closed", "open")
+    assert o["motion"] is None
+    assert c["motion"]["counts"]["grasp verified"] == 2
+    assert {e["kind"] for e in c["motion"]["events"]} >= {"grasp verified"}

@@ -30,8 +30,11 @@ def results(plan, tmp_path_factory) -> dict[str, dict]:
     res = {}
     for strategy in ("mixed", "position", "pwm"):
         path = out / f"{strategy}.json"
-        code = main([str(plan), "--strategy", strategy, "--json", str(path)])
+        code = main([str(plan), "--strategy", strategy, "--open-loop", "--json", str(path)])
         res[strategy] = {"code": code, **json.loads(path.read_text())}
+    path = out / "pwm-closed.json"
+    code = main([str(plan), "--strategy", "pwm", "--json", str(path)])
+    res["pwm closed"] = {"code": code, **json.loads(path.read_text())}
     return res
 
 
@@ -72,6 +75,7 @@ def test_mixed_climbs_the_fixture(results):
 
 
 def test_strategies_differ_and_say_why(results):
+    """Open loop, as the thesis played them."""
     pos, pwm = results["position"], results["pwm"]
     assert results["mixed"]["code"] == 0
     # compliant arms cannot lift themselves to the rails (duty clamp, back-EMF)
@@ -80,11 +84,20 @@ def test_strategies_differ_and_say_why(results):
     assert pwm["details"]["palm_to_axis_m"] > 0.02
     # position and mixed both grasp; the PWM hold phase of mixed tracks worse
     assert pos["code"] == 0
-    te = {k: v["metrics"]["tracking_error_rad"] for k, v in results.items()}
+    te = {k: v["metrics"]["tracking_error_rad"] for k, v in results.items() if k in
+          ("mixed", "position", "pwm")}
     assert te["mixed"]["left"] > 1.5 * te["position"]["left"]
     for arm in ("left", "right"):
         assert te["pwm"][arm] >= 10 * te["position"][arm]
     assert {r["strategy"] for r in results.values()} == {"mixed", "position", "pwm"}
+
+
+def test_closed_loop_pwm_grasps_what_open_loop_misses(results):
+    """The motion layer's gravity compensation and grasp checks get the PWM-only arms
+    onto the rails of the fixture."""
+    r = results["pwm closed"]
+    assert r["loop"] == "closed" and r["code"] == 0 and r["verdict"] == "climbed"
+    assert r["motion"]["counts"]["grasp verified"] == 2
 
 
 def test_plots_written_or_rendering_reported(plan, tmp_path):

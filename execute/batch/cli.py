@@ -1,13 +1,15 @@
 """``batch-eval``: success rates over ladders × seeds × strategies × perturbations.
 
     batch-eval [--ladders drc,ship,stair | --sweep SWEEP.yaml] [--seeds N] [--first-seed S]
-               [--strategies mixed,position,pwm] [--perturb KEY=V,...] [--draws D]
+               [--strategies mixed,position,pwm] [--loop closed,open]
+               [--perturb KEY=V,...] [--draws D]
                [--engine local|dask] [--address tcp://host:8786] [--workers K]
                [--out DIR] [--time-limit S] [--top-rung K] [--robot R] [--rate HZ]
                [--max-jobs N] [--no-plots] [-v]
 
-Per (ladder, seed) one plan (seeds S..S+N−1), then per strategy × perturbation draw one
-simulated climb of that plan (`execute.batch.jobs`; perturbations:
+Per (ladder, seed) one plan (seeds S..S+N−1), then per strategy × loop × perturbation
+draw one simulated climb of that plan (closed loop through the motion layer, open loop
+as the file is; both loops of a strategy see the same draws) (`execute.batch.jobs`; perturbations:
 `execute.batch.perturb`; sweeps: `execute.batch.sweep`). Jobs run on a local process
 pool or a Dask cluster (`execute.batch.engine`). Every finished job is appended to
 ``DIR/results.jsonl``; running the same command again skips finished jobs and retries
@@ -37,6 +39,7 @@ __all__ = ["main", "parse_args"]
 log = logging.getLogger("batch-eval")
 
 STRATEGIES = ("mixed", "position", "pwm")
+LOOPS = ("closed", "open")
 MAX_SEEDS = 10_000
 MAX_WORKERS = 256
 
@@ -52,6 +55,9 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--first-seed", type=int, default=1, metavar="S", help="first seed (default 1)")
     p.add_argument("--strategies", default=",".join(STRATEGIES),
                    help="comma-separated arm strategies (default mixed,position,pwm)")
+    p.add_argument("--loop", default="closed", metavar="closed,open",
+                   help="play each plan through the motion layer (closed), as the file is "
+                        "(open), or both, on the same perturbation draws (default closed)")
     p.add_argument("--perturb", default="", metavar="KEY=V,...",
                    help="placement=M,yaw=RAD,rung=M,friction=LO:HI,battery=LO:HI")
     p.add_argument("--draws", type=int, default=1, metavar="D",
@@ -132,6 +138,10 @@ def parse_args(argv: list[str] | None = None) -> dict:
     if bad:
         raise InputError(f"option --strategies: {', '.join(bad)} unknown; choose from "
                          f"{', '.join(STRATEGIES)}")
+    loops = _split("--loop", a.loop)
+    bad = [x for x in loops if x not in LOOPS]
+    if bad or len(set(loops)) != len(loops):
+        raise InputError(f"option --loop is {a.loop!r}; give closed, open or closed,open")
     perturb = parse_perturb(a.perturb)
     if a.draws > 1 and not perturb:
         raise InputError(f"option --draws is {a.draws}, but there is no --perturb: every draw "
@@ -158,7 +168,7 @@ def parse_args(argv: list[str] | None = None) -> dict:
                              f"0..{spec.num_rungs - 1}")
     workers = a.workers or os.cpu_count() or 1
     return {"ladders": ladders, "seeds": list(range(a.first_seed, a.first_seed + a.seeds)),
-            "strategies": strategies, "perturb": perturb, "draws": a.draws,
+            "strategies": strategies, "loops": loops, "perturb": perturb, "draws": a.draws,
             "engine": a.engine, "address": a.address, "workers": workers, "out": Path(a.out),
             "time_limit_s": a.time_limit, "top_rung": a.top_rung, "robot": a.robot,
             "rate_hz": a.rate, "max_jobs": a.max_jobs, "plots": not a.no_plots,
@@ -185,7 +195,7 @@ def run(opts: dict, console, err, functions=None, engine=None) -> int:
     )
 
     from execute.batch.engine import open_engine
-    from execute.batch.jobs import DEFAULT_JOB_FUNCTIONS, expand_jobs
+    from execute.batch.jobs import DEFAULT_JOB_FUNCTIONS, expand_jobs, run_label
     from execute.batch.report import (
         print_summary,
         summarize_records,
@@ -197,7 +207,8 @@ def run(opts: dict, console, err, functions=None, engine=None) -> int:
     plans, validations = expand_jobs(opts["ladders"], opts["seeds"], opts["strategies"],
                                      opts["perturb"], opts["draws"], robot=opts["robot"],
                                      time_limit_s=opts["time_limit_s"],
-                                     top_rung=opts["top_rung"], rate_hz=opts["rate_hz"])
+                                     top_rung=opts["top_rung"], rate_hz=opts["rate_hz"],
+                                     loops=opts["loops"])
     out: Path = opts["out"]
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
@@ -233,13 +244,14 @@ def run(opts: dict, console, err, functions=None, engine=None) -> int:
             eng.close()
     expected: dict[tuple[str, str], int] = {}
     for v in validations:
-        k = (v.plan.ladder_key, v.strategy)
+        k = (v.plan.ladder_key, v.label)
         expected[k] = expected.get(k, 0) + 1
     expected_plans: dict[str, int] = {}
     for p in plans:
         expected_plans[p.ladder_key] = expected_plans.get(p.ladder_key, 0) + 1
     summary = summarize_records(batch.records, {k: s for k, s, _ in opts["ladders"]},
-                                opts["strategies"], expected, expected_plans)
+                                [run_label(s, lp) for s in opts["strategies"]
+                                 for lp in opts["loops"]], expected, expected_plans)
     print_summary(summary, console)
     files = [write_csv(summary, out / "summary.csv"), write_markdown(summary, out / "summary.md")]
     if opts["plots"]:

@@ -103,37 +103,58 @@ class ValidateJob:
         plan: the plan job this depends on.
         strategy: ``mixed``, ``position`` or ``pwm``.
         draw_index: index of the perturbation draw (0-based).
-        draw: the drawn perturbation.
+        draw: the drawn perturbation (the same for both loops: runs pair up).
+        loop: ``closed`` (through the motion layer) or ``open`` (the file as it is).
     """
 
     plan: PlanJob
     strategy: str
     draw_index: int
     draw: Draw
+    loop: str = "closed"
 
     kind = "validate"
 
     @property
     def key(self) -> str:
         return f"validate/{self.plan.ladder_key}/s{self.plan.seed}/{self.strategy}/" \
-               f"d{self.draw_index}"
+               f"{self.loop}/d{self.draw_index}"
 
     @property
     def fingerprint(self) -> str:
         return _fingerprint({"kind": "validate", "plan": self.plan.fingerprint,
-                             "strategy": self.strategy, "draw": self.draw.to_json()})
+                             "strategy": self.strategy, "loop": self.loop,
+                             "draw": self.draw.to_json()})
 
     def describe(self) -> dict:
         return {"key": self.key, "fingerprint": self.fingerprint, "kind": self.kind,
                 "ladder": self.plan.ladder_key, "seed": self.plan.seed,
                 "sweep": dict(self.plan.sweep), "strategy": self.strategy,
-                "draw": self.draw_index, "perturbation": self.draw.to_json()}
+                "loop": self.loop, "draw": self.draw_index,
+                "perturbation": self.draw.to_json()}
+
+    @property
+    def label(self) -> str:
+        """The row of the summary this run counts in."""
+        return run_label(self.strategy, self.loop)
+
+
+def run_label(strategy: str, loop: str) -> str:
+    """``"mixed closed"``: a strategy played open or closed loop."""
+    return f"{strategy} {loop}"
+
+
+def record_label(record: dict) -> str:
+    """The summary row of a validate record (records written before the loop axis
+    existed were open loop)."""
+    return run_label(record["strategy"], record.get("loop", "open"))
 
 
 def expand_jobs(ladders: Sequence[tuple[str, LadderSpec, dict[str, Any]]], seeds: Sequence[int],
                 strategies: Sequence[str], perturb: PerturbSpec, draws: int = 1, *,
                 robot: str = "drc-hubo", time_limit_s: float = 600.0,
-                top_rung: int | None = None, rate_hz: float = DAEMON_RATE_HZ
+                top_rung: int | None = None, rate_hz: float = DAEMON_RATE_HZ,
+                loops: Sequence[str] = ("closed",)
                 ) -> tuple[list[PlanJob], list[ValidateJob]]:
     """Every job of a batch.
 
@@ -144,9 +165,10 @@ def expand_jobs(ladders: Sequence[tuple[str, LadderSpec, dict[str, Any]]], seeds
         perturb: what to perturb.
         draws: perturbation draws per (plan, strategy).
         robot, time_limit_s, top_rung, rate_hz: planning settings (see `PlanJob`).
+        loops: ``closed`` and/or ``open``; both loops of a strategy see the same draws.
 
     Returns:
-        (plan jobs, validate jobs), in ladder, seed, strategy, draw order.
+        (plan jobs, validate jobs), in ladder, seed, strategy, loop, draw order.
     """
     plans, validations = [], []
     for key, spec, sweep in ladders:
@@ -155,9 +177,10 @@ def expand_jobs(ladders: Sequence[tuple[str, LadderSpec, dict[str, Any]]], seeds
                         tuple(sweep.items()))
             plans.append(p)
             for strategy in strategies:
-                for i in range(draws):
-                    validations.append(ValidateJob(p, strategy, i,
-                                                   draw(perturb, key, int(seed), strategy, i)))
+                for loop in loops:
+                    for i in range(draws):
+                        validations.append(ValidateJob(
+                            p, strategy, i, draw(perturb, key, int(seed), strategy, i), loop))
     return plans, validations
 
 
@@ -232,7 +255,8 @@ def validate_job(job: ValidateJob, plan_outcome: dict, out_dir: str) -> dict:
     d = job.draw
     opts = SimulationOptions(strategy=job.strategy,
                              placement=PlacementError(d.dx_m, d.dy_m, d.dyaw_rad),
-                             board=BoardModelConfig(battery_v=d.battery_v), record_qpos=False)
+                             board=BoardModelConfig(battery_v=d.battery_v), record_qpos=False,
+                             closed_loop=job.loop == "closed")
     run = simulate(traj, sidecar, d.physical_ladder(job.plan.ladder), opts, sidecar.robot)
     metrics = compute_metrics(run)
     result = result_json(run, metrics, plan_outcome["traj"],

@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from execute.batch.jobs import record_label
 from execute.batch.stats import Distribution, SuccessRate, summarize
 from ladders.spec import LadderSpec
 
@@ -97,8 +98,9 @@ def summarize_records(records: Iterable[dict], ladders: Mapping[str, LadderSpec]
     Args:
         records: the latest record of each job of the batch.
         ladders: ladder key → spec (table order).
-        strategies: strategies in table order.
-        expected: (ladder, strategy) → number of validate jobs in the batch.
+        strategies: run labels (`execute.batch.jobs.run_label`, "mixed closed") in table
+            order.
+        expected: (ladder, run label) → number of validate jobs in the batch.
         expected_plans: ladder → number of plan jobs.
     """
     strategies = list(strategies)
@@ -110,7 +112,7 @@ def summarize_records(records: Iterable[dict], ladders: Mapping[str, LadderSpec]
         if r["kind"] == "plan":
             plans.setdefault(r["ladder"], []).append(r)
         else:
-            val.setdefault((r["ladder"], r["strategy"]), []).append(r)
+            val.setdefault((r["ladder"], record_label(r)), []).append(r)
     rows = []
     for key, spec in ladders.items():
         for s in strategies:

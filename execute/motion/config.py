@@ -2,14 +2,12 @@
 
 from __future__ import annotations
 
-import enum
 import math
 from dataclasses import dataclass, field
 
 from robot.errors import InputError
 
-__all__ = ["EstimatorConfig", "HoldingArmReference", "MotionConfig", "MotionConfigError",
-           "default_config"]
+__all__ = ["EstimatorConfig", "MotionConfig", "MotionConfigError", "default_config"]
 
 
 class MotionConfigError(InputError):
@@ -34,15 +32,9 @@ class EstimatorConfig:
     tilt_filter_s: float = 0.05
 
 
-class HoldingArmReference(enum.Enum):
-    """What a compliant arm whose hand holds a verified grip is stiff towards."""
-
-    PLAN = "plan"  #: the plan's reference, through the daemon's filter (hubo-ach's PWM law)
-    SENSED = "sensed"  #: its own encoders (mode COMPLIANT): feed-forward and damping only
-
-
 #: field → (lowest, highest) allowed value.
 _RANGES = {
+    "holding_arm_stiffness": (0.0, 1.0),
     "max_reach_correction_m": (0.0, 0.10),
     "max_reach_correction_rad": (0.0, math.radians(30.0)),
     "grasp_retries": (0, 8),
@@ -60,7 +52,12 @@ class MotionConfig:
     """Attributes:
         gravity_compensation: feed the compliant arms the model's gravity torques at the
             sensed configuration and IMU tilt (thesis §4.3.4) instead of the plan's.
-        holding_arm_reference: what a gripping compliant arm is stiff towards.
+        holding_arm_stiffness: share of the daemon's PWM stiffness (kp) with which a
+            gripping compliant arm is pulled towards the plan's reference: its reference is
+            sent as ``pos + share·(plan − pos)``. 1 is hubo-ach's PWM law on the plan; 0
+            leaves the feed-forward and damping alone (the thesis's gravity-compensation
+            mode). A stiff arm fights the closed chain and bends the grip; a limp one leaves
+            the legs the load the plan gave the arms.
         max_reach_correction_m: largest shift of a hold target, estimate plus search [m].
         max_reach_correction_rad: largest ladder yaw the estimate may apply [rad].
         grasp_retries: re-reaches after a grasp the fingers show empty.
@@ -73,7 +70,7 @@ class MotionConfig:
     """
 
     gravity_compensation: bool = True
-    holding_arm_reference: HoldingArmReference = HoldingArmReference.PLAN
+    holding_arm_stiffness: float = 1.0
     max_reach_correction_m: float = 0.06
     max_reach_correction_rad: float = math.radians(15.0)
     grasp_retries: int = 4

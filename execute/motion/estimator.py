@@ -4,10 +4,10 @@
   reaction to gravity, which gives the pelvis's roll and pitch (hubo-motion-rt used the
   waist IMU the same way).
 - **Pose** by leg odometry. The world frame is the robot's start frame: the soles stand
-  flat, facing its x axis, where the plan's first stance puts them. A foot whose F/T sensor carries load
-  (``foot_contact_on_n``) is anchored where the estimate puts it as it lands; while
-  anchored, the pelvis pose follows from that foot's pose and the leg's encoders. A foot
-  that unloads (``foot_contact_off_n``) drops its anchor.
+  flat, facing its x axis, where the plan's first stance puts them. A foot whose F/T
+  sensor carries load (``foot_contact_on_n``) is anchored where the estimate puts it as
+  it lands; while anchored, the pelvis pose follows from that foot's pose and the leg's
+  encoders. A foot that unloads (``foot_contact_off_n``) drops its anchor.
 - **Limb poses**: palms and soles in the world from the pose and the encoders.
 - **Finger curl** per hand, the mean of its five finger encoders: what grasp verification
   reads (`execute.motion.grasp_check`).

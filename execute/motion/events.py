@@ -46,7 +46,8 @@ class MotionEvent:
     def __str__(self) -> str:
         size = f" {self.size_m * 100:.1f} cm" if self.size_m else ""
         who = f" {self.limb}" if self.limb else ""
-        return f"t = {self.time_s:.2f} s, line {self.line}: {self.kind.value}{who}{size}: {self.cause}"
+        return (f"t = {self.time_s:.2f} s, line {self.line}: {self.kind.value}{who}{size}: "
+                f"{self.cause}")
 
 
 @dataclass(frozen=True)

@@ -4,8 +4,10 @@ A hand's fingers stop where they meet a rail lying in the grip
 (`robot.kinematic_tree.finger_contact_curl_rad`: 0.09 rad on a 25 mm rail) and close to
 ``FINGER_CLOSED_RAD`` (1.6 rad) on nothing. So, with the fingers commanded closed:
 
-- **on rail**: the mean curl stands still below half of closed;
-- **empty**: it has passed ``empty_fraction`` of closed;
+- **on rail**: the mean curl stands still where this rail stops the fingers (from its
+  contact curl, less ``CONTACT_SLACK_RAD``, up to half of closed); fingers that stand
+  still short of the rail have not closed at all;
+- **empty**: it has passed ``EMPTY_FRACTION`` of closed;
 - **closing**: neither yet.
 
 The thesis's operator could not tell this from the wrist F/T sensors (§6.2: their fz
@@ -20,7 +22,7 @@ import enum
 import numpy as np
 
 from robot.joints import FINGER_JOINTS, joint_indices
-from robot.kinematic_tree import FINGER_CLOSED_RAD
+from robot.kinematic_tree import FINGER_CLOSED_RAD, finger_contact_curl_rad
 
 __all__ = ["GraspReading", "read_grasp"]
 
@@ -28,6 +30,7 @@ _FINGER_COLS = {side: joint_indices(FINGER_JOINTS[side]) for side in FINGER_JOIN
 ON_RAIL_FRACTION = 0.5  #: below this share of closed, a still hand holds something
 EMPTY_FRACTION = 0.8  #: past this share of closed, the hand closed on nothing
 STILL_RAD_S = 0.2  #: mean finger speed under which the fingers stand still [rad/s]
+CONTACT_SLACK_RAD = 0.03  #: how far short of the rail's contact curl a grip may read [rad]
 
 
 class GraspReading(enum.Enum):
@@ -36,13 +39,16 @@ class GraspReading(enum.Enum):
     CLOSING = "closing"
 
 
-def read_grasp(side: str, pos_rad: np.ndarray, vel_rad_s: np.ndarray) -> GraspReading:
-    """What the finger encoders of one hand, commanded closed, say (module docstring)."""
+def read_grasp(side: str, pos_rad: np.ndarray, vel_rad_s: np.ndarray,
+               rail_radius_m: float) -> GraspReading:
+    """What the finger encoders of one hand, commanded closed on a rail of radius
+    ``rail_radius_m`` [m], say (module docstring)."""
     cols = _FINGER_COLS[side]
     curl = float(np.mean(pos_rad[cols]))
     speed = float(np.mean(np.abs(vel_rad_s[cols])))
     if curl >= EMPTY_FRACTION * FINGER_CLOSED_RAD:
         return GraspReading.EMPTY
-    if curl < ON_RAIL_FRACTION * FINGER_CLOSED_RAD and speed < STILL_RAD_S:
+    on_rail = finger_contact_curl_rad(rail_radius_m) - CONTACT_SLACK_RAD
+    if on_rail <= curl < ON_RAIL_FRACTION * FINGER_CLOSED_RAD and speed < STILL_RAD_S:
         return GraspReading.ON_RAIL
     return GraspReading.CLOSING

@@ -1,4 +1,5 @@
-"""Where the ladder really stands, from the grasps the fingers confirmed.
+"""Where the ladder really stands, from the grasps the fingers confirmed while the robot
+stood on the floor (`execute.motion.layer` adds only those: there leg odometry is exact).
 
 A hand closed on a rail has the rail's axis in its grip centre, so each verified grasp
 measures, through the encoders and leg odometry, where that rail is. Against the plan's

@@ -34,7 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from daemon.control_modes import RefMode
-from execute.motion.config import HoldingArmReference, MotionConfig
+from execute.motion.config import MotionConfig
 from execute.motion.estimator import BodyEstimate, StateEstimator
 from execute.motion.events import MotionEvent, MotionEventKind, MotionStop
 from execute.motion.grasp_check import GraspReading, read_grasp
@@ -42,7 +42,7 @@ from execute.motion.gravity_compensation import ArmGravityCompensation
 from execute.motion.ladder_estimate import LadderEstimate, RailObservation
 from execute.motion.robot_model import MotionRobotModel
 from execute.motion.sensed_state import SensedState
-from execute.motion.wrist_relief import WRIST_ROLL, WristRollRelief
+from execute.motion.wrist_relief import WRIST_ROLL, WristRelief
 from execute.play.player import PlayerTick, TrajectoryPlayer
 from ladders.geometry import LadderGeometry
 from ladders.spec import LadderSpec
@@ -56,8 +56,10 @@ log = logging.getLogger(__name__)
 SIDES = ("left", "right")
 #: Re-reach pattern, in search steps (towards the ladder across the rail, sideways).
 SEARCH_PATTERN = ((1, 0), (0, 1), (0, -1), (-1, 0), (2, 0), (1, 1), (1, -1), (-2, 0))
-#: A correction smaller than this is not applied [m].
-MIN_CORRECTION_M = 0.002
+#: A correction smaller than this is not applied [m]: the estimate's own error (leg
+#: odometry drift, a hand settled off the axis within the grip) is below it, and the grip
+#: and the feet tolerate it.
+MIN_CORRECTION_M = 0.01
 #: Two targets closer than this are the same [m].
 SAME_TARGET_M = 0.005
 
@@ -128,7 +130,7 @@ class MotionLayer:
                  if limb.endswith("_foot")}
         self.estimator = StateEstimator(self.model, soles, self.config.estimator)
         self.gravity = ArmGravityCompensation(self.model)
-        self.wrist_relief = WristRollRelief(robot)
+        self.wrist_relief = WristRelief(robot)
         self._last_now: float | None = None
         self.ladder = LadderEstimate(self.config.max_reach_correction_m,
                                      self.config.max_reach_correction_rad)
@@ -196,6 +198,14 @@ class MotionLayer:
                                           R_world_pelvis.T @ shift_world_m,
                                           R_world_pelvis.T @ turn_world @ R_world_pelvis)
 
+    def _ladder_shift(self, planned_m: np.ndarray) -> np.ndarray:
+        """Where the ladder estimate puts a hold planned at ``planned_m``, as a shift [m]:
+        zero without an estimate or below `MIN_CORRECTION_M`, bounded above."""
+        if not self.ladder.observed:
+            return np.zeros(3)
+        shift = self._bounded(self.ladder.correction_m(planned_m))
+        return shift if float(np.linalg.norm(shift)) >= MIN_CORRECTION_M else np.zeros(3)
+
     def _bounded(self, shift_m: np.ndarray) -> np.ndarray:
         length = float(np.linalg.norm(shift_m))
         cap = self.config.max_reach_correction_m
@@ -208,9 +218,8 @@ class MotionLayer:
             if seg.phase != "limb" or not self._on_ladder(hold.target):
                 continue
             current = self._offset(limb, float(self._line))
-            shift = self._bounded(self.ladder.correction_m(hold.position_m)) \
-                if self.ladder.observed else np.zeros(3)
-            if float(np.linalg.norm(shift)) < MIN_CORRECTION_M:
+            shift = self._ladder_shift(np.asarray(hold.position_m))
+            if not shift.any():
                 if current is None:
                     continue
                 dq, residual = np.zeros_like(current), 0.0
@@ -250,7 +259,7 @@ class MotionLayer:
             return _Regrasp(side, k, rail, planned, "verify", self._now)
         if line_index == seg.first_line - 1 and self.ladder.observed:
             limb = f"{side}_hand"
-            wanted = self._bounded(self.ladder.correction_m(planned))
+            wanted = self._ladder_shift(planned)
             if np.linalg.norm(wanted - self._shift_m.get(limb, np.zeros(3))) > SAME_TARGET_M:
                 g = _Regrasp(side, k, rail, planned, "retarget", self._now)
                 self._move_hand(g, wanted, "the ladder estimate moved its target")
@@ -260,7 +269,7 @@ class MotionLayer:
     def _candidates(self, g: _Regrasp) -> list[np.ndarray]:
         """Re-reach shifts [m]: the ladder estimate's target, then a pattern around it,
         each within the bound and different from where the hand closed last."""
-        centre = self.ladder.correction_m(g.planned_m) if self.ladder.observed else np.zeros(3)
+        centre = self._ladder_shift(g.planned_m)
         towards_ladder = -self.geometry.rung_line_normal
         step = self.config.search_step_m
         out: list[np.ndarray] = []
@@ -296,7 +305,7 @@ class MotionLayer:
                 self._regrasp = None
                 self.player.resume(now)
         elif g.phase in ("verify", "close"):
-            reading = read_grasp(g.side, s.pos_rad, s.vel_rad_s)
+            reading = read_grasp(g.side, s.pos_rad, s.vel_rad_s, self.geometry.spec.rail_radius_m)
             waited = cfg.verify_timeout_s + (cfg.close_s if g.phase == "close" else 0.0)
             if reading is GraspReading.ON_RAIL and (g.phase == "verify" or elapsed >= cfg.close_s):
                 self._grasp_verified(g)
@@ -347,10 +356,16 @@ class MotionLayer:
                     f"palm {np.round(off * 100, 1).tolist()} cm from the planned hold"
                     + (f" after {g.tries} re-reach{'es' if g.tries != 1 else ''}"
                        if g.tries else ""))
-        self.ladder.add(RailObservation(g.rail, g.planned_m, palm, self._rail_direction(g.rail)))
-        self._event(MotionEventKind.LADDER_ESTIMATE, "", float(np.linalg.norm(self.ladder.shift_m)),
-                    f"ladder shifted {np.round(self.ladder.shift_m * 100, 1).tolist()} cm, "
-                    f"yawed {np.degrees(self.ladder.yaw_rad):.1f}°")
+        seg = self.sidecar.segments[g.segment]
+        if all(h.target == "floor" for limb, h in seg.holds.items() if limb.endswith("_foot")):
+            # standing on the floor, leg odometry is exact; on the ladder it carries the
+            # feet's creep, which would read as the ladder moving
+            self.ladder.add(RailObservation(g.rail, g.planned_m, palm,
+                                            self._rail_direction(g.rail)))
+            self._event(MotionEventKind.LADDER_ESTIMATE, "",
+                        float(np.linalg.norm(self.ladder.shift_m)),
+                        f"ladder shifted {np.round(self.ladder.shift_m * 100, 1).tolist()} "
+                        f"cm, yawed {np.degrees(self.ladder.yaw_rad):.1f}°")
         self._regrasp = None
         self.player.resume(self._now)
 
@@ -385,7 +400,7 @@ class MotionLayer:
     def _command(self, tick: PlayerTick, s: SensedState) -> PlayerTick:
         plan_rad = tick.ref_rad
         ref = plan_rad.copy()
-        for limb, blend in self._offsets.items():
+        for blend in self._offsets.values():
             t = self._now if blend.time_based else float(tick.line_index)
             ref += blend.at(t)
         for side in self._open_fingers:
@@ -399,11 +414,15 @@ class MotionLayer:
             cols = self._arm_cols[side]
             gripping = (hold is not None and hold.target.startswith("rail")
                         and bool(tick.comply[cols].all()))
-            ref[WRIST_ROLL[side]] += self.wrist_relief.update(side, gripping, s.cur_a, dt)
-            if gripping and self.config.holding_arm_reference is HoldingArmReference.SENSED:
+            wrist_roll = WRIST_ROLL[side]
+            ref[wrist_roll] += self.wrist_relief.update(wrist_roll, gripping, s.cur_a, dt)
+            share = self.config.holding_arm_stiffness
+            if gripping and share < 1.0:
+                soft = [c for c in cols if c != wrist_roll]
+                ref[soft] = s.pos_rad[soft] + share * (ref[soft] - s.pos_rad[soft])
                 if mode is tick.mode:
                     mode = tick.mode.copy()
-                mode[cols] = RefMode.COMPLIANT
+                mode[soft] = RefMode.DIRECT  # the share is the stiffness; no filter lag
         ff = tick.feedforward_nm
         if self.config.gravity_compensation:
             ff = self.gravity.feedforward_nm(ff, plan_rad, s.pos_rad, self.estimate.R_tilt)
@@ -418,7 +437,7 @@ class MotionLayer:
             counts[ev.kind.value] = counts.get(ev.kind.value, 0) + 1
         return {
             "config": {"gravity_compensation": self.config.gravity_compensation,
-                       "holding_arm_reference": self.config.holding_arm_reference.value,
+                       "holding_arm_stiffness": self.config.holding_arm_stiffness,
                        "max_reach_correction_m": self.config.max_reach_correction_m,
                        "grasp_retries": self.config.grasp_retries},
             "counts": counts,

@@ -1,10 +1,11 @@
 """What the robot's sensors report, and nothing else: the motion layer's only input.
 
-`SensedState.from_sample` reads one ``daemon.structs.STATE_DTYPE`` sample, the struct the
-daemon publishes on its ``state`` channel on the robot and in simulation alike: encoders
-(joints and fingers), joint velocities, motor currents, the four F/T sensors, the three
-IMUs, which boards are powered and which joints comply. There is no other way into the motion layer, so it
-cannot see the simulator's ground truth, contacts or grip latch.
+`SensedState.from_sample` reads one ``daemon.structs.STATE_DTYPE`` sample, the struct
+the daemon publishes on its ``state`` channel on the robot and in simulation alike:
+encoders (joints and fingers), joint velocities, motor currents, the four F/T sensors,
+the three IMUs, which boards are powered and which joints comply. There is no other way
+into the motion layer, so it cannot see the simulator's ground truth, contacts or grip
+latch.
 """
 
 from __future__ import annotations

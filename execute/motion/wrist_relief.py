@@ -1,12 +1,12 @@
-"""Relief of a gripping hand's wrist roll, the one joint of a compliant arm that cannot
+"""Relief of a gripping compliant arm's wrist roll, the one joint of the arm that cannot
 comply (it shares a 3-channel board with the fingers, hubo-facts §2).
 
-With the hand closed on its rail, every twist of the grip about the forearm loads the
-wrist roll's position loop, and when its board trips the fingers let go. The motor
-current says how hard it pushes (``τ = η·gear·Kt·I``, `robot.motors`). While that torque
-is above ``relief_fraction`` of the joint's limit, the wrist roll's reference walks
-towards where the grip wants it, at ``relief_speed_rad_s``, within ``max_offset_rad``;
-the offset is kept while the hand holds and unwound while it moves in the air.
+With the hand closed on its rail, a twist of the grip loads its position loop; when its
+board trips, the fingers let go. The motor current says how hard a joint pushes (``τ =
+η·gear·Kt·I``, `robot.motors`). While that torque is above ``relief_fraction`` of the
+joint's limit, its reference walks towards where the grip wants it, at
+``relief_speed_rad_s``, within ``max_offset_rad``; the offset is kept while the hand
+holds and unwound while it moves in the air.
 """
 
 from __future__ import annotations
@@ -17,13 +17,13 @@ from robot.joints import JOINT_INDEX
 from robot.limits import joint_limits
 from robot.motors import MotorTable, motor_table
 
-__all__ = ["WristRollRelief"]
+__all__ = ["WRIST_ROLL", "WristRelief"]
 
 WRIST_ROLL = {"left": JOINT_INDEX["LWR"], "right": JOINT_INDEX["RWR"]}
 
 
-class WristRollRelief:
-    """Per-hand wrist-roll offsets from the sensed motor current (module docstring).
+class WristRelief:
+    """Offsets of rigid joints from their sensed motor currents (module docstring).
 
     Args:
         robot: robot name (torque limits).
@@ -40,12 +40,12 @@ class WristRollRelief:
         self.relief_fraction = relief_fraction
         self.speed = relief_speed_rad_s
         self.max_offset_rad = max_offset_rad
-        self.offset_rad = {"left": 0.0, "right": 0.0}
+        self.offset_rad: dict[int, float] = {}
 
-    def update(self, side: str, holding: bool, cur_a: np.ndarray, dt_s: float) -> float:
-        """The wrist roll's offset after one tick [rad]."""
-        j = WRIST_ROLL[side]
-        off = self.offset_rad[side]
+    def update(self, joint: int, holding: bool, cur_a: np.ndarray, dt_s: float) -> float:
+        """The offset of column ``joint`` after one tick [rad]."""
+        j = joint
+        off = self.offset_rad.get(j, 0.0)
         if holding:
             torque = float(cur_a[j] * self.motors.efficiency[j] * self.motors.gear[j]
                            * self.motors.kt_nm_per_a[j])
@@ -55,5 +55,5 @@ class WristRollRelief:
         else:
             off -= np.sign(off) * min(abs(off), self.speed * dt_s)
         off = float(np.clip(off, -self.max_offset_rad, self.max_offset_rad))
-        self.offset_rad[side] = off
+        self.offset_rad[j] = off
         return off

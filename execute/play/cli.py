@@ -1,7 +1,7 @@
 """``play-trajectory``: hubo-read-trajectory's flags, playing a 40-column file to the daemon.
 
     play-trajectory -n FILE [-f 10|25|50|100|200|500] [-i] [-c|-cl|-cr] [-nf] [-p]
-                    [-line N] [--no-auto-modes] [--instance NAME] [--robot R]
+                    [-line N] [--open-loop] [--no-auto-modes] [--instance NAME] [--robot R]
                     [--clamp-limits TOL]
 
 Before anything is sent, the whole file is checked (`robot.trajectory_file`): a bad file
@@ -26,6 +26,12 @@ without ``-i`` refuses to start when the robot stands farther than ``--line-tole
 from the start line (``-line N``, 1-based). With ``-i`` it first moves there smoothly
 (minimum jerk, ``--init-s``, 3 s).
 
+With a sidecar, playback is closed loop by default: the motion layer (`execute.motion`)
+reads the daemon's ``state`` channel every tick, checks every grasp from the finger
+encoders before the plan loads it, re-reaches a miss, re-targets later reaches and
+compensates the compliant arms' gravity. If a grasp cannot be made it stops and holds
+(exit 1). ``--open-loop`` plays the file as hubo-read-trajectory did.
+
 It streams one ``ref`` sample per 5 ms (absolute deadlines), ``playing`` set, and shows
 the line, the time and the arms' modes. With ``-p``: the ``p`` key (when stdin is a
 terminal) and SIGUSR1 toggle pause; resuming continues where it stopped (no catch-up).
@@ -33,8 +39,8 @@ At the end, and on Ctrl-C / SIGTERM, the last reference stays on the channel wit
 ``playing`` cleared: the robot holds it.
 
 Exit codes: 0 played to the end, 1 refused or failed (no daemon, not homed, too far from
-the start line), 2 bad input or another player on the instance, 130 stopped by Ctrl-C
-(holding).
+the start line, a grasp the motion layer could not make), 2 bad input or another player
+on the instance, 130 stopped by Ctrl-C (holding).
 """
 
 from __future__ import annotations
@@ -83,6 +89,10 @@ def _parser() -> argparse.ArgumentParser:
                    help="pause feature: key p (terminal) or SIGUSR1 toggles pause")
     p.add_argument("-line", dest="line", type=int, default=1, metavar="N",
                    help="start at 1-based line N")
+    p.add_argument("--open-loop", action="store_true",
+                   help="play the file as hubo-read-trajectory did; by default a plan with a "
+                        "sidecar plays through the motion layer (grasp checks, re-reach, "
+                        "reach correction, gravity compensation) on the daemon's state")
     p.add_argument("--no-auto-modes", action="store_true",
                    help="ignore the sidecar's per-arm position/PWM schedule and "
                         "feed-forward")
@@ -137,7 +147,14 @@ def _load(args):
     if not (np.isfinite(args.line_tolerance) and args.line_tolerance > 0):
         raise InputError(f"--line-tolerance {args.line_tolerance}: must be > 0 [rad]")
     player = TrajectoryPlayer(traj, opts, schedule, sidecar.arm_feedforward if auto else None)
-    return traj, player, auto
+    motion = None
+    if auto and not args.open_loop:
+        from execute.motion.layer import MotionLayer
+        from execute.validate.cli import ladder_from_sidecar
+
+        ladder = ladder_from_sidecar(sidecar.ladder, f"{side}: ladder")
+        motion = MotionLayer(player, traj, sidecar, ladder, robot)
+    return traj, player, auto, motion
 
 
 def _wait_for_daemon(state, instance: str) -> np.ndarray:
@@ -204,7 +221,7 @@ class _Keys:
         termios.tcsetattr(self.fd, termios.TCSADRAIN, self._saved)
 
 
-def _play(args, traj, player, auto) -> int:
+def _play(args, traj, player, auto, motion=None) -> int:
     from daemon.channels import open_channel
     from daemon.loop import sleep_until_ns
     from daemon.structs import REF_DTYPE, new_sample
@@ -255,8 +272,8 @@ def _play(args, traj, player, auto) -> int:
                 break
             # The state only matters for go-to-init's start pose and the feed-forward's
             # battery voltage.
-            latest = state.read_latest() if not player.started or player.has_feedforward \
-                else None
+            latest = state.read_latest() if (motion is not None or not player.started
+                                             or player.has_feedforward) else None
             # go-to-init starts from the measured pose, within the limits (the daemon
             # rejects a reference beyond them; an encoder may read a hair past one)
             pos = np.clip(latest["pos"], limits.lower_rad, limits.upper_rad) \
@@ -265,7 +282,14 @@ def _play(args, traj, player, auto) -> int:
                 while flags["toggles"]:
                     flags["toggles"] -= 1
                     player.toggle_pause(now_s)
-            tick = player.step(now_s, pos)
+            tick = player.step(now_s, pos) if motion is None else motion.step(now_s, latest)
+            if motion is not None and motion.stop is not None:
+                sample["playing"] = 0  # hold: every verified grip kept, nothing loaded
+                ref.write(sample)
+                print(f"\nplay-trajectory: the motion layer stopped at line "
+                      f"{motion.stop.line} and holds: {motion.stop.reason}",
+                      file=sys.stderr, flush=True)
+                return 1
             sample["ref"] = tick.ref_rad
             sample["mode"] = tick.mode
             sample["comply"] = tick.comply
@@ -313,9 +337,9 @@ def main(argv: list[str] | None = None) -> int:
     def job() -> int:
         from execute.play.lock import PlayerLock
 
-        traj, player, auto = _load(args)
+        traj, player, auto, motion = _load(args)
         with PlayerLock(args.instance):  # one player per daemon; before any channel
-            return _play(args, traj, player, auto)
+            return _play(args, traj, player, auto, motion)
 
     try:
         return run_cli("play-trajectory", job)

@@ -2,7 +2,8 @@
 
     validate-plan PLAN.traj [--ladder L] [--strategy mixed|position|pwm] [--battery V]
                   [--placement-error dx,dy,dyaw] [--json R.json] [--video V.mp4]
-                  [--plots DIR] [--robot R]
+                  [--plots DIR] [--robot R] [--open-loop] [--max-reach-correction M]
+                  [--grasp-retries N] [--holding-arm-stiffness S]
 
 Reads ``PLAN.traj`` and its sidecar ``PLAN.plan.json`` (rate, holds, arm schedule,
 ladder), runs `execute.validate.simulate.simulate`, prints the verdict and the metrics, and
@@ -39,6 +40,18 @@ def _parser() -> argparse.ArgumentParser:
                    help="battery voltage [V] (default 48)")
     p.add_argument("--placement-error", default="0,0,0", metavar="dx,dy,dyaw",
                    help="ladder misplacement [m, m, rad]")
+    p.add_argument("--open-loop", action="store_true",
+                   help="play the file as hubo-read-trajectory did, without the motion layer "
+                        "(default: closed loop on the sensed state)")
+    p.add_argument("--max-reach-correction", type=float, default=0.06, metavar="M",
+                   help="closed loop: largest shift of a hold target [m], within [0, 0.10] "
+                        "(default 0.06)")
+    p.add_argument("--grasp-retries", type=int, default=4, metavar="N",
+                   help="closed loop: re-reaches of a hand that closed on nothing, within "
+                        "[0, 8] (default 4)")
+    p.add_argument("--holding-arm-stiffness", type=float, default=1.0, metavar="S",
+                   help="closed loop: share of the PWM stiffness pulling a gripping arm "
+                        "towards the plan, within [0, 1] (default 1)")
     p.add_argument("--json", metavar="R.json", help="write the result here")
     p.add_argument("--video", metavar="V.mp4", help="write an MP4 (needs EGL)")
     p.add_argument("--plots", metavar="DIR", help="write tracking plots and a snapshot strip")
@@ -59,6 +72,23 @@ def ladder_from_sidecar(d: dict, where: str):
         return LadderSpec(**d)
     except TypeError as exc:
         raise InputError(f"{where}: field 'ladder' is not a ladder spec: {exc}") from None
+
+
+def motion_config(args: argparse.Namespace):
+    """The motion layer's settings from the flags (refused outside their ranges)."""
+    from execute.motion.config import MotionConfig
+
+    return MotionConfig(max_reach_correction_m=args.max_reach_correction,
+                        grasp_retries=args.grasp_retries,
+                        holding_arm_stiffness=args.holding_arm_stiffness)
+
+
+def motion_summary(report: dict) -> str:
+    """One line on what the motion layer did."""
+    counts = report["counts"]
+    done = ", ".join(f"{n} {kind}" for kind, n in sorted(counts.items())) or "no correction"
+    shift = [round(v * 100, 1) for v in report["ladder_shift_m"]]
+    return f"motion layer: {done}; ladder estimated {shift} cm off the plan"
 
 
 def _why(run, metrics, comparison=None) -> str:
@@ -92,12 +122,14 @@ def result_json(run, metrics, plan_path: str, comparison=None) -> dict:
         "details": {} if f is None else f.details,
         "final_holds": v.final_holds,
         "strategy": run.options.strategy,
+        "loop": "closed" if run.options.closed_loop else "open",
         "battery_v": run.options.board.battery_v,
         "placement_error": {"dx_m": pe.dx_m, "dy_m": pe.dy_m, "dyaw_rad": pe.dyaw_rad},
         "board_trips": [str(t) for t in run.log.trips],
         "grasp_events": [str(g) for g in run.log.grasps],
         "metrics": metrics.to_json(),
         "plan_vs_sim": None if comparison is None else comparison.to_json(),
+        "motion": run.motion,
     }
 
 
@@ -126,12 +158,15 @@ def _run(args: argparse.Namespace) -> int:
     board_cfg = BoardModelConfig(battery_v=args.battery)
     opts = SimulationOptions(strategy=args.strategy,
                              placement=PlacementError.parse(args.placement_error),
-                             board=board_cfg)
+                             board=board_cfg, closed_loop=not args.open_loop,
+                             motion=motion_config(args))
     run = simulate(traj, sidecar, ladder, opts, robot)
     metrics = compute_metrics(run)
     comparison = compare_with_plan(run, traj, ladder)
     result = result_json(run, metrics, str(plan), comparison)
     print(f"{result['verdict']}: {result['why']}")
+    if run.motion is not None:
+        print(motion_summary(run.motion))
     print(f"simulated {metrics.simulated_s:.2f} s at {metrics.real_time_factor:.1f}× real "
           f"time")
     if args.json:

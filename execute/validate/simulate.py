@@ -36,8 +36,10 @@ from daemon.pwm import PwmGains, default_drc_gains
 from daemon.sim.board_model import TICK_S, BoardModel, BoardModelConfig, PlacementError
 from daemon.sim.board_trip import TripEvent
 from daemon.sim.grasp_latch import GraspEvent
+from daemon.structs import STATE_DTYPE, new_sample
+from execute.motion.config import MotionConfig
 from execute.play.player import ArmModeSchedule, PlayerOptions, TrajectoryPlayer
-from execute.validate.verdict import Verdict, VerdictConfig, VerdictMonitor
+from execute.validate.verdict import Failure, Verdict, VerdictConfig, VerdictMonitor
 from ladders.geometry import LadderGeometry
 from ladders.spec import LadderSpec
 from robot.errors import InputError
@@ -60,6 +62,10 @@ class SimulationOptions:
         gains: PWM gains (`daemon.pwm.default_drc_gains` when None).
         stop_on_failure: end the run at the first failure.
         record_qpos: keep every tick's qpos (for snapshots and video).
+        closed_loop: play through the motion layer (`execute.motion`), on the state
+            struct the daemon publishes; False plays the file open loop, as
+            hubo-read-trajectory did.
+        motion: the motion layer's tunables (`execute.motion.MotionConfig` when None).
     """
 
     strategy: str = "mixed"
@@ -69,6 +75,8 @@ class SimulationOptions:
     gains: PwmGains | None = None
     stop_on_failure: bool = True
     record_qpos: bool = True
+    closed_loop: bool = True
+    motion: MotionConfig | None = None
 
     def __post_init__(self) -> None:
         if self.strategy not in STRATEGIES:
@@ -106,6 +114,7 @@ class SimulationRun:
     wall_s: float
     simulated_s: float
     rate_hz: float
+    motion: dict | None = None  # what the motion layer did (`MotionLayer.report`)
 
     @property
     def real_time_factor(self) -> float:
@@ -119,6 +128,53 @@ def _schedule(strategy: str, sidecar: PlanSidecar, n: int) -> tuple[ArmModeSched
     if strategy == "pwm":
         return ArmModeSchedule.all_position(n), frozenset({"left", "right"})
     return ArmModeSchedule.all_position(n), frozenset()
+
+
+
+class _Recorder:
+    """Per-tick records in arrays that grow as the run goes on (a closed-loop run lasts
+    as long as its waits and re-reaches)."""
+
+    def __init__(self, ticks: int, nq: int):
+        self.n = 0
+        self.nq = nq
+        self.arrays = {"t": np.zeros(ticks), "line": np.zeros(ticks, dtype=np.int32),
+                       "ref": np.zeros((ticks, 40)), "pos": np.zeros((ticks, 40)),
+                       "tau": np.zeros((ticks, 40)), "pwm": np.zeros((ticks, 40), dtype=bool),
+                       "latched": np.zeros((ticks, 2), dtype=bool), "com": np.zeros((ticks, 3)),
+                       "sole": np.zeros((ticks, 2, 3))}
+        if nq:
+            self.arrays["qpos"] = np.zeros((ticks, nq))
+        self.trips: list[TripEvent] = []
+        self.grasps: list[GraspEvent] = []
+
+    def add(self, board: BoardModel, out, line_index: int, com_m: np.ndarray, sole_sites,
+            trips: list[TripEvent], grasps: list[GraspEvent]) -> None:
+        a, k = self.arrays, self.n
+        if k == len(a["t"]):
+            for key, arr in a.items():
+                a[key] = np.concatenate([arr, np.zeros_like(arr)])
+        a["t"][k] = board.time_s
+        a["line"][k] = line_index
+        a["ref"][k] = out.ref_sent_rad
+        a["pos"][k] = board.joint_pos()
+        a["tau"][k] = board.joint_torque()
+        a["pwm"][k] = out.pwm
+        a["latched"][k] = (board.latches["left"].latched, board.latches["right"].latched)
+        a["com"][k] = com_m
+        a["sole"][k, 0], a["sole"][k, 1] = sole_sites[0].xpos, sole_sites[1].xpos
+        if self.nq:
+            a["qpos"][k] = board.data.qpos
+        self.trips += trips
+        self.grasps += grasps
+        self.n += 1
+
+    def log(self) -> SimulationLog:
+        a, n = self.arrays, self.n
+        return SimulationLog(a["t"][:n], a["line"][:n], a["ref"][:n], a["pos"][:n],
+                             a["tau"][:n], a["pwm"][:n], a["latched"][:n], a["com"][:n],
+                             a["sole"][:n], a["qpos"][:n] if self.nq else None,
+                             self.trips, self.grasps)
 
 
 def simulate(trajectory_rad: np.ndarray, sidecar: PlanSidecar, ladder: LadderSpec,
@@ -155,65 +211,63 @@ def simulate(trajectory_rad: np.ndarray, sidecar: PlanSidecar, ladder: LadderSpe
                               schedule, sidecar.arm_feedforward)
     controller = JointController(robot=robot)
     gains = opt.gains or default_drc_gains()
-    monitor = VerdictMonitor(board, sidecar, T_err, player.time_of_line, opt.verdict)
+    monitor = VerdictMonitor(board, sidecar, T_err, opt.verdict)
+    motion = None
+    state = new_sample(STATE_DTYPE)
+    if opt.closed_loop:
+        from execute.motion.layer import MotionLayer  # pinocchio: only when closing the loop
 
-    total_ticks = int(math.ceil((player.duration_s + opt.verdict.settle_s) / TICK_S))
-    nq = board.model.nq
-    t_arr = np.zeros(total_ticks)
-    line_arr = np.zeros(total_ticks, dtype=np.int32)
-    ref = np.zeros((total_ticks, 40))
-    pos = np.zeros((total_ticks, 40))
-    tau = np.zeros((total_ticks, 40))
-    pwm = np.zeros((total_ticks, 40), dtype=bool)
-    latched = np.zeros((total_ticks, 2), dtype=bool)
-    com = np.zeros((total_ticks, 3))
-    sole = np.zeros((total_ticks, 2, 3))
-    qpos = np.zeros((total_ticks, nq)) if opt.record_qpos else None
-    trips_all: list[TripEvent] = []
-    grasps_all: list[GraspEvent] = []
+        motion = MotionLayer(player, trajectory_rad, sidecar, ladder, robot, opt.motion)
+    rec = _Recorder(int(math.ceil((player.duration_s + opt.verdict.settle_s) / TICK_S)),
+                    board.model.nq if opt.record_qpos else 0)
     d = board.data
     pelvis = monitor.pelvis
     sole_sites = [d.site("L_sole"), d.site("R_sole")]
     failure = None
     line_index = 0
+    finished_at = stopped_at = None
     k = 0
     wall0 = time.perf_counter()
-    for k in range(total_ticks):
+    while True:
         now = k * TICK_S
         pos_now = board.joint_pos()
         vel_now = board.joint_vel()
-        tick = player.step(now, pos_now)
+        if motion is None:
+            tick = player.step(now, pos_now)
+        else:
+            board.fill_state(state)
+            tick = motion.step(now, state)
         line_index = tick.line_index
         out = controller.tick(tick.ref_rad, tick.mode, tick.comply, pos_now, vel_now, gains,
                               player.feedforward_duty(tick, opt.board.battery_v, board.motors))
         board.apply(out)
         trips, grasps = board.step()
-        trips_all += trips
-        grasps_all += grasps
-        t_arr[k] = board.time_s
-        line_arr[k] = line_index
-        ref[k] = out.ref_sent_rad
-        pos[k] = board.joint_pos()
-        tau[k] = board.joint_torque()
-        pwm[k] = out.pwm
-        latched[k] = (board.latches["left"].latched, board.latches["right"].latched)
-        com[k] = d.subtree_com[pelvis]
-        sole[k, 0], sole[k, 1] = sole_sites[0].xpos, sole_sites[1].xpos
-        if qpos is not None:
-            qpos[k] = d.qpos
+        rec.add(board, out, line_index, d.subtree_com[pelvis], sole_sites, trips, grasps)
+        k += 1
         if failure is None:
             failure = monitor.check(board.time_s, line_index, trips, grasps)
             if failure is not None:
                 log.info("failure: %s", failure.why)
                 if opt.stop_on_failure:
                     break
+        if motion is not None and motion.stop is not None:
+            stopped_at = board.time_s if stopped_at is None else stopped_at
+            if board.time_s - stopped_at >= motion.config.hold_after_stop_s - 1e-9:
+                break
+        if tick.finished:
+            finished_at = board.time_s if finished_at is None else finished_at
+            if board.time_s - finished_at >= opt.verdict.settle_s - 1e-9:
+                break
     wall = time.perf_counter() - wall0
-    used = k + 1
-    sim_log = SimulationLog(t_arr[:used], line_arr[:used], ref[:used], pos[:used],
-                            tau[:used], pwm[:used], latched[:used], com[:used], sole[:used],
-                            None if qpos is None else qpos[:used], trips_all, grasps_all)
+    sim_log = rec.log()
+    if failure is None and motion is not None and motion.stop is not None:
+        stop = motion.stop
+        failure = Failure("grasp_unverified", stop.time_s, stop.line,
+                          f"the motion layer held the pose and stopped: {stop.reason}",
+                          {"limb": stop.limb, "tries": stop.tries, **stop.details})
     if failure is not None:
         verdict = Verdict(False, failure, {})
     else:
         verdict = monitor.final(board.time_s, line_index)
-    return SimulationRun(verdict, sim_log, board, sidecar, opt, wall, board.time_s, rate)
+    return SimulationRun(verdict, sim_log, board, sidecar, opt, wall, board.time_s, rate,
+                         None if motion is None else motion.report())

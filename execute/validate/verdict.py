@@ -54,7 +54,8 @@ def default_config() -> VerdictConfig:
 @dataclass(frozen=True)
 class Failure:
     """Why a run failed: ``cause`` (``fall``, ``hard_contact``, ``board_trip``,
-    ``grasp_not_latched``, ``grasp_lost``, ``final_stance``), when, on which line, and a
+    ``grasp_not_latched``, ``grasp_lost``, ``final_stance``, ``grasp_unverified``: the
+    motion layer could not confirm a grasp and held the pose), when, on which line, and a
     sentence with the physical quantities behind it."""
 
     cause: str
@@ -89,16 +90,15 @@ class VerdictMonitor:
         sidecar: the plan's sidecar (holds per segment, final holds).
         T_err: 4×4 world transform of the ladder's misplacement (identity if none);
             planned positions on the ladder move with it.
-        line_time_s: 0-based line index → time it starts [s].
         config: thresholds.
     """
 
-    def __init__(self, board, sidecar: PlanSidecar, T_err: np.ndarray, line_time_s,
+    def __init__(self, board, sidecar: PlanSidecar, T_err: np.ndarray,
                  config: VerdictConfig | None = None):
         self.board = board
         self.sidecar = sidecar
         self.T_err = T_err
-        self.line_time_s = line_time_s
+        self._segment_entry: tuple[int, float] = (-1, 0.0)  # (first line, time entered)
         self.config = config or default_config()
         m = board.model
         self.model, self.data = m, board.data
@@ -180,8 +180,9 @@ class VerdictMonitor:
                     return Failure("grasp_lost", time_s, line,
                                    f"{g.hand} hand let go of {g.rail}: {g.reason}",
                                    {"hand": g.hand, "rail": g.rail, "reason": g.reason})
-        seg_start = self.line_time_s(seg.first_line - 1)
-        if time_s - seg_start >= self.config.latch_grace_s:
+        if self._segment_entry[0] != seg.first_line:
+            self._segment_entry = (seg.first_line, time_s)  # played lines, pauses counted
+        if time_s - self._segment_entry[1] >= self.config.latch_grace_s:
             for limb, hold in seg.holds.items():
                 if not (limb.endswith("_hand") and hold.target.startswith("rail")):
                     continue
