@@ -40,7 +40,7 @@ def _drc_plan(tmp: str) -> Path:
 def run() -> list[dict]:
     """Time one simulated climb per strategy; report simulated s / wall s."""
     from execute.validate.simulate import SimulationOptions, simulate
-    from ladders.spec import LadderSpec
+    from ladders.loader import sidecar_ladder
     from robot.plan_sidecar import read_sidecar, sidecar_path
     from robot.trajectory_file import read_trajectory
 
@@ -51,11 +51,7 @@ def run() -> list[dict]:
                 Path(choice) if choice else _drc_plan(tmp))
         sc = read_sidecar(sidecar_path(plan))
         traj = read_trajectory(plan, sc.rate_hz, sc.robot)
-        if "geometry" in sc.ladder:
-            from execute.validate.cli import ladder_from_sidecar
-            ladder = ladder_from_sidecar(sc.ladder, str(plan))
-        else:
-            ladder = LadderSpec(**sc.ladder)
+        ladder = sidecar_ladder(sc, str(plan))
         for strategy in ("mixed", "position"):
             run_ = simulate(traj, sc, ladder, SimulationOptions(
                 strategy=strategy, record_qpos=False, stop_on_failure=False), sc.robot)

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import logging
 import os
+from collections.abc import Callable
 from dataclasses import MISSING, fields
 from importlib import resources
 from pathlib import Path
@@ -39,6 +40,7 @@ import yaml
 
 from ladders.spec import FIELD_RULES, LadderFieldError, LadderSpec, check_field
 from robot.errors import InputError, LadderSpecError
+from robot.plan_sidecar import PlanSidecar
 
 logger = logging.getLogger(__name__)
 
@@ -159,52 +161,112 @@ def parse_ladder_yaml(text: str, source: str = "<string>") -> LadderSpec:
     problems = YamlProblems(source)
     root, top = document_items(text, problems, "a ladder spec mapping with sections "
                                + ", ".join(s for s in LAYOUT if s))
+    spec = _spec_from_layout(
+        top, root, lambda section, node: mapping_items(node, f"section '{section}'", problems),
+        _scalar, problems.add, problems.raise_if_any)
+    logger.debug("loaded ladder %r from %s", spec.name, source)
+    return spec
+
+
+def ladder_from_mapping(doc: Any, source: str) -> LadderSpec:
+    """Validate a ladder spec given as a mapping in the file layout (as a plan sidecar
+    holds it), by the same rules as a spec file.
+
+    Raises:
+        LadderSpecError: ``SOURCE: field 'geometry.slope_deg' ...``, one problem per line.
+    """
+    problems: list[str] = []
+
+    def add(_where: object, message: str) -> None:
+        problems.append(f"{source}: {message}")
+
+    def raise_if_any() -> None:
+        if problems:
+            error = LadderSpecError("\n".join(problems))
+            error.problems = list(problems)  # type: ignore[attr-defined]
+            raise error
+
+    def items(what: str, value: Any) -> dict[str, tuple[str, Any]] | None:
+        if not isinstance(value, dict):
+            add(None, f"{what} is {type(value).__name__}, expected a mapping of keys to values")
+            return None
+        return {str(k): (k, v) for k, v in value.items()}
+
+    top = items("the ladder", doc)
+    raise_if_any()
+    assert top is not None
+    return _spec_from_layout(top, None, lambda section, value: items(f"section '{section}'",
+                                                                     value),
+                             lambda value: value, add, raise_if_any)
+
+
+def sidecar_ladder(sidecar: PlanSidecar, source: str) -> LadderSpec:
+    """The ladder spec a plan sidecar holds (field ``ladder``), checked by the spec's rules.
+
+    Raises:
+        LadderSpecError: ``SOURCE: field 'ladder': field 'geometry.slope_deg' ...``.
+    """
+    return ladder_from_mapping(sidecar.ladder, f"{source}: field 'ladder'")
+
+
+def _spec_from_layout(top: dict[str, tuple[Any, Any]], root: Any,
+                      section_items: Callable[[str, Any], dict[str, tuple[Any, Any]] | None],
+                      value_of: Callable[[Any], Any], add: Callable[[Any, str], None],
+                      raise_if_any: Callable[[], None]) -> LadderSpec:
+    """The spec of a document in the file layout, whatever it was read from.
+
+    Args:
+        top: the document's top level, key → (where the key is, where its value is).
+        root: where the document is (for problems of the whole document).
+        section_items: a section's entries like ``top``, or None (problem added).
+        value_of: the Python value at a value's place.
+        add: records a problem at a place.
+        raise_if_any: raises the problems recorded so far, if any.
+    """
     values: dict[str, Any] = {}
-    nodes: dict[str, yaml.Node] = {}
+    places: dict[str, Any] = {}
     valid_top = [k for k in LAYOUT[None]] + [s for s in LAYOUT if s]
-    for key, (key_node, _) in top.items():
+    for key, (key_place, _) in top.items():
         if key not in valid_top:
-            problems.add(key_node, _unknown_key_message(key, valid_top))
+            add(key_place, _unknown_key_message(key, valid_top))
     for section, keys in LAYOUT.items():
         if section is None:
-            entries: dict[str, tuple[yaml.Node, yaml.Node]] | None = top
-            anchor: yaml.Node = root
+            entries: dict[str, tuple[Any, Any]] | None = top
+            anchor = root
         elif section in top:
             anchor = top[section][1]
-            entries = mapping_items(anchor, f"section '{section}'", problems)
+            entries = section_items(section, anchor)
         else:
             anchor, entries = root, {}
         if entries is None:
             continue
-        for key, (key_node, _) in entries.items():
+        for key, (key_place, _) in entries.items():
             if section is not None and key not in keys:
-                problems.add(key_node, _unknown_key_message(f"{section}.{key}", list(keys)))
+                add(key_place, _unknown_key_message(f"{section}.{key}", list(keys)))
         for key, field in keys.items():
             path = FILE_KEYS[field]
             if key not in entries:
                 if field not in _OPTIONAL_FIELDS:
                     where = f"section '{section}'" if section else "the top level"
-                    problems.add(anchor, f"field '{path}' is missing from {where} "
-                                 f"(required, {FIELD_RULES[field].describe()})")
+                    add(anchor, f"field '{path}' is missing from {where} "
+                        f"(required, {FIELD_RULES[field].describe()})")
                 continue
-            value_node = entries[key][1]
-            nodes[field] = value_node
+            value_place = entries[key][1]
+            places[field] = value_place
             try:
-                values[field] = check_field(field, _scalar(value_node))
+                values[field] = check_field(field, value_of(value_place))
             except LadderFieldError as exc:
-                problems.add(value_node, f"field '{path}' {exc.reason}")
+                add(value_place, f"field '{path}' {exc.reason}")
             except yaml.YAMLError as exc:
-                problems.add(value_node, f"field '{path}': {exc}")
-    problems.raise_if_any()
+                add(value_place, f"field '{path}': {exc}")
+    raise_if_any()
     try:
-        spec = LadderSpec(**values)
+        return LadderSpec(**values)
     except LadderFieldError as exc:
         field = exc.fields[0]
-        problems.add(nodes.get(field, root), f"field '{FILE_KEYS[field]}' {exc.reason}")
-        problems.raise_if_any()
+        add(places.get(field, root), f"field '{FILE_KEYS[field]}' {exc.reason}")
+        raise_if_any()
         raise  # pragma: no cover - raise_if_any always raises here
-    logger.debug("loaded ladder %r from %s", spec.name, source)
-    return spec
 
 
 def bundled_ladder_path(name: str) -> Path:
@@ -246,8 +308,9 @@ def load_ladder(name_or_path: str | os.PathLike[str]) -> LadderSpec:
     return parse_ladder_yaml(text, str(path))
 
 
-def ladder_to_yaml(spec: LadderSpec) -> str:
-    """The spec as YAML text in the file layout (floats written exactly, so it round-trips)."""
+def ladder_to_mapping(spec: LadderSpec) -> dict[str, Any]:
+    """The spec as a mapping in the file layout (what a plan sidecar holds);
+    `ladder_from_mapping` reads it back to an equal spec."""
     doc: dict[str, Any] = {}
     for section, keys in LAYOUT.items():
         entries = {key: getattr(spec, field) for key, field in keys.items()}
@@ -255,6 +318,12 @@ def ladder_to_yaml(spec: LadderSpec) -> str:
             doc.update(entries)
         else:
             doc[section] = entries
+    return doc
+
+
+def ladder_to_yaml(spec: LadderSpec) -> str:
+    """The spec as YAML text in the file layout (floats written exactly, so it round-trips)."""
+    doc = ladder_to_mapping(spec)
     header = (f"# Ladder spec '{spec.name}' (hubo-ladder). Units are in the key names.\n"
               "# placement = pose of the ladder frame (floor, rung line, lateral centre) in the\n"
               "# robot's start frame.\n")
@@ -274,4 +343,5 @@ def dump_ladder(spec: LadderSpec, path: str | os.PathLike[str]) -> Path:
 
 
 __all__ = ["BUNDLED_LADDERS", "FILE_KEYS", "LAYOUT", "bundled_ladder_path", "dump_ladder",
-           "ladder_to_yaml", "load_ladder", "parse_ladder_yaml"]
+           "ladder_from_mapping", "ladder_to_mapping", "ladder_to_yaml", "load_ladder",
+           "parse_ladder_yaml", "sidecar_ladder"]

@@ -391,9 +391,7 @@ def write_plan(result: SearchResult, planner: ClimbPlanner, out_traj: str | os.P
     Raises:
         TimingError: a segment could not be timed within the joint limits.
     """
-    import yaml
-
-    from ladders.loader import ladder_to_yaml
+    from ladders.loader import ladder_to_mapping
     from planner.timing import TimingConfig, time_parameterize
     from robot.limits import joint_limits
 
@@ -431,7 +429,7 @@ def write_plan(result: SearchResult, planner: ClimbPlanner, out_traj: str | os.P
     all_timings["timing_s"] = t_timed - t0
     all_timings["output_s"] = time.perf_counter() - t_timed
     sidecar = PlanSidecar(
-        robot=kin.params.name, ladder=yaml.safe_load(ladder_to_yaml(planner.spec)),
+        robot=kin.params.name, ladder=ladder_to_mapping(planner.spec),
         rate_hz=float(rate_hz), line_count=timed.line_count, segments=tuple(segments),
         arm_modes=arm_modes,
         final_holds={h.limb: _record(h) for h in sorted(result.final_stance.holds,

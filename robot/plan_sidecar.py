@@ -2,6 +2,14 @@
 
 Written by ``plan-ladder``, read by ``validate-plan``, ``play-trajectory`` and
 ``check-plan``. Line numbers are 1-based and inclusive, like the trajectory file's.
+
+`read_sidecar` checks every field once, at the edge, and names the field of any problem
+(``segments[3].first_line: expected an integer ≥ 1, got 'x'``). The ladder spec inside
+is kept as the mapping of its file layout; ``ladders.loader.sidecar_ladder`` parses it
+with the spec's own rules (this package may not import ``ladders``).
+
+Versions: 2 is this layout. Version 1 grew fields without changing its number, so a
+version-1 file is refused with a message that says to plan again.
 """
 
 from __future__ import annotations
@@ -17,11 +25,10 @@ import numpy as np
 
 from robot.errors import InputError
 from robot.joints import ARM_JOINTS, JOINT_NAMES
+from robot.vocabulary import ARM_MODES, LIMBS, HoldTarget, HoldTargetError, SegmentPhase, Side
 
 FORMAT = "hubo-ladder-plan"
-VERSION = 1
-ARM_MODES = ("position", "pwm")
-LIMBS = ("left_hand", "right_hand", "left_foot", "right_foot")
+VERSION = 2
 
 
 class SidecarError(InputError):
@@ -32,8 +39,12 @@ class SidecarError(InputError):
 class HoldRecord:
     """One hold in contact: what it holds and where the limb frame must be [m]."""
 
-    target: str  # "floor", "rung_3", "rail_left", ...
+    target: str  # "floor", "rung_3", "rail_left", ... (`hold_target` parses it)
     position_m: tuple[float, float, float]
+
+    @property
+    def hold_target(self) -> HoldTarget:
+        return HoldTarget.parse(self.target)
 
 
 @dataclass(frozen=True)
@@ -152,14 +163,60 @@ def write_sidecar(path: str | os.PathLike, sidecar: PlanSidecar) -> None:
     tmp.replace(path)
 
 
+def _need(d: dict, key: str, where: str) -> Any:
+    if key not in d:
+        raise SidecarError(f"{where}: missing field '{key}'")
+    return d[key]
+
+
+def _int(value: Any, where: str, minimum: int | None = None) -> int:
+    if not isinstance(value, int) or isinstance(value, bool) or \
+            (minimum is not None and value < minimum):
+        at_least = "" if minimum is None else f" ≥ {minimum}"
+        raise SidecarError(f"{where}: expected an integer{at_least}, got {value!r}")
+    return value
+
+
+def _number(value: Any, where: str, positive: bool = False) -> float:
+    ok = isinstance(value, int | float) and not isinstance(value, bool) and \
+        np.isfinite(value) and (value > 0 or not positive)
+    if not ok:
+        raise SidecarError(f"{where}: expected a {'positive' if positive else 'finite'} "
+                           f"number, got {value!r}")
+    return float(value)
+
+
+def _text(value: Any, where: str) -> str:
+    if not isinstance(value, str):
+        raise SidecarError(f"{where}: expected a string, got {value!r}")
+    return value
+
+
+def _mapping(value: Any, where: str) -> dict:
+    if not isinstance(value, dict):
+        raise SidecarError(f"{where}: expected a mapping, got {value!r}")
+    return value
+
+
+def _list(value: Any, where: str) -> list:
+    if not isinstance(value, list):
+        raise SidecarError(f"{where}: expected a list, got {value!r}")
+    return value
+
+
 def _hold(d: Any, where: str) -> HoldRecord:
     if not isinstance(d, dict) or set(d) != {"target", "position_m"}:
         raise SidecarError(f"{where}: a hold needs exactly 'target' and 'position_m'")
+    target = _text(d["target"], f"{where}.target")
+    try:
+        HoldTarget.parse(target)
+    except HoldTargetError as exc:
+        raise SidecarError(f"{where}.target: {exc}") from None
     pos = d["position_m"]
     if not (isinstance(pos, list) and len(pos) == 3 and all(isinstance(v, int | float)
                                                            for v in pos)):
         raise SidecarError(f"{where}.position_m: expected 3 numbers [m], got {pos!r}")
-    return HoldRecord(str(d["target"]), tuple(float(v) for v in pos))
+    return HoldRecord(target, tuple(float(v) for v in pos))
 
 
 def _holds(d: Any, where: str) -> dict[str, HoldRecord]:
@@ -169,6 +226,26 @@ def _holds(d: Any, where: str) -> dict[str, HoldRecord]:
         if limb not in LIMBS:
             raise SidecarError(f"{where}: unknown limb {limb!r}; limbs are {', '.join(LIMBS)}")
     return {limb: _hold(h, f"{where}.{limb}") for limb, h in d.items()}
+
+
+def _segment(s: Any, where: str, line_count: int) -> Segment:
+    s = _mapping(s, where)
+    first = _int(_need(s, "first_line", where), f"{where}.first_line", 1)
+    last = _int(_need(s, "last_line", where), f"{where}.last_line", 1)
+    if not first <= last <= line_count:
+        raise SidecarError(f"{where}: lines {first}..{last} are outside 1..{line_count}")
+    phase = _text(_need(s, "phase", where), f"{where}.phase")
+    if phase not in tuple(SegmentPhase):
+        raise SidecarError(f"{where}.phase: expected one of "
+                           f"{', '.join(SegmentPhase)}, got {phase!r}")
+    moving = _list(s.get("moving_limbs", []), f"{where}.moving_limbs")
+    for i, limb in enumerate(moving):
+        if limb not in LIMBS:
+            raise SidecarError(f"{where}.moving_limbs[{i}]: unknown limb {limb!r}; limbs "
+                               f"are {', '.join(LIMBS)}")
+    return Segment(_text(_need(s, "primitive", where), f"{where}.primitive"), phase,
+                   _int(_need(s, "rung", where), f"{where}.rung"), first, last,
+                   _holds(_need(s, "holds", where), f"{where}.holds"), tuple(moving))
 
 
 def _runs(runs: Any, where: str, line_count: int) -> list[tuple[int, int, str]]:
@@ -216,45 +293,59 @@ def _feedforward(d: Any, where: str, line_count: int) -> ArmFeedforward | None:
     return ArmFeedforward(every, tuple(joints), torque)
 
 
-def read_sidecar(path: str | os.PathLike) -> PlanSidecar:
-    """Read and validate a sidecar. Raises `SidecarError` naming the file and the field."""
-    path = Path(path)
+def _json_document(path: Path) -> Any:
+    """The file's JSON value; a byte that is not UTF-8 or a syntax error is reported at
+    its line and column."""
     try:
-        d = json.loads(path.read_text())
+        raw = path.read_bytes()
     except OSError as exc:
         raise SidecarError(f"{path}: cannot read: {exc.strerror}") from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = raw.count(b"\n", 0, exc.start) + 1
+        column = exc.start - (raw.rfind(b"\n", 0, exc.start) + 1) + 1
+        raise SidecarError(f"{path}:{line}:{column}: byte 0x{raw[exc.start]:02x} is not "
+                           f"UTF-8 text") from None
+    try:
+        return json.loads(text)
     except json.JSONDecodeError as exc:
         raise SidecarError(f"{path}:{exc.lineno}:{exc.colno}: invalid JSON: {exc.msg}") from None
+
+
+def read_sidecar(path: str | os.PathLike) -> PlanSidecar:
+    """Read and validate a sidecar. Raises `SidecarError` naming the file and the field
+    (``FILE: segments[2].holds.left_hand.target: ...``)."""
+    path = Path(path)
+    d = _json_document(path)
     if not isinstance(d, dict) or d.get("format") != FORMAT:
         raise SidecarError(f"{path}: not a {FORMAT} file (field 'format')")
-    if d.get("version") != VERSION:
-        raise SidecarError(f"{path}: field 'version' is {d.get('version')!r}; this reader "
+    version = d.get("version")
+    if version == 1:
+        raise SidecarError(f"{path}: field 'version' is 1, a layout that changed without "
+                           f"its number; this reader reads version {VERSION}: plan again "
+                           f"with plan-ladder")
+    if version != VERSION:
+        raise SidecarError(f"{path}: field 'version' is {version!r}; this reader "
                            f"reads version {VERSION}")
-    try:
-        n = int(d["line_count"])
-        if tuple(d["joint_order"]) != JOINT_NAMES:
-            raise SidecarError(f"{path}: field 'joint_order' is not the 40-column order")
-        segments = []
-        for i, s in enumerate(d["segments"]):
-            where = f"{path}: segments[{i}]"
-            if not 1 <= s["first_line"] <= s["last_line"] <= n:
-                raise SidecarError(f"{where}: lines {s['first_line']}..{s['last_line']} are "
-                                   f"outside 1..{n}")
-            segments.append(Segment(s["primitive"], s["phase"], int(s["rung"]),
-                                    int(s["first_line"]), int(s["last_line"]),
-                                    _holds(s["holds"], f"{where}.holds"),
-                                    tuple(s.get("moving_limbs", ()))))
-        arm_modes = {arm: _runs(d["arm_modes"].get(arm), f"{path}: arm_modes.{arm}", n)
-                     for arm in ("left", "right")}
-        return PlanSidecar(
-            robot=d["robot"], ladder=d["ladder"], rate_hz=float(d["rate_hz"]), line_count=n,
-            segments=tuple(segments), arm_modes=arm_modes,
-            final_holds=_holds(d["final_holds"], f"{path}: final_holds"),
-            seed=int(d.get("seed", 0)), metrics=d.get("metrics", {}),
-            timings_s=d.get("timings_s", {}), planner_version=d.get("planner_version", ""),
-            arm_feedforward=_feedforward(d.get("arm_feedforward"), f"{path}: arm_feedforward",
-                                         n))
-    except KeyError as exc:
-        raise SidecarError(f"{path}: missing field {exc.args[0]!r}") from None
-    except (TypeError, ValueError) as exc:
-        raise SidecarError(f"{path}: malformed field: {exc}") from None
+    where = f"{path}:"
+    n = _int(_need(d, "line_count", where), f"{where} line_count", 1)
+    if _list(_need(d, "joint_order", where), f"{where} joint_order") != list(JOINT_NAMES):
+        raise SidecarError(f"{path}: field 'joint_order' is not the 40-column order")
+    segments = tuple(_segment(s, f"{where} segments[{i}]", n)
+                     for i, s in enumerate(_list(_need(d, "segments", where),
+                                                 f"{where} segments")))
+    arm_modes = _mapping(_need(d, "arm_modes", where), f"{where} arm_modes")
+    return PlanSidecar(
+        robot=_text(_need(d, "robot", where), f"{where} robot"),
+        ladder=_mapping(_need(d, "ladder", where), f"{where} ladder"),
+        rate_hz=_number(_need(d, "rate_hz", where), f"{where} rate_hz", positive=True),
+        line_count=n, segments=segments,
+        arm_modes={arm: _runs(arm_modes.get(arm), f"{where} arm_modes.{arm}", n)
+                   for arm in map(str, Side)},
+        final_holds=_holds(_need(d, "final_holds", where), f"{where} final_holds"),
+        seed=_int(d.get("seed", 0), f"{where} seed"),
+        metrics=_mapping(d.get("metrics", {}), f"{where} metrics"),
+        timings_s=_mapping(d.get("timings_s", {}), f"{where} timings_s"),
+        planner_version=_text(d.get("planner_version", ""), f"{where} planner_version"),
+        arm_feedforward=_feedforward(d.get("arm_feedforward"), f"{where} arm_feedforward", n))

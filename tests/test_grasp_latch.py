@@ -19,10 +19,10 @@ from daemon.joint_control import JointController  # noqa: E402
 from daemon.pwm import default_drc_gains  # noqa: E402
 from daemon.sim.board_model import PlacementError  # noqa: E402
 from daemon.sim.grasp_latch import GripCapacity, GripConfig  # noqa: E402
-from ladders.contact_model import GripGeometry  # noqa: E402
 from execute.validate.metrics import compute_metrics  # noqa: E402
 from execute.validate.simulate import SimulationOptions, simulate  # noqa: E402
-from ladders.spec import LadderSpec  # noqa: E402
+from ladders.contact_model import GripGeometry  # noqa: E402
+from ladders.loader import sidecar_ladder  # noqa: E402
 from robot.joints import ARM_JOINTS, FINGER_JOINTS, JOINT_INDEX, NUM_JOINTS  # noqa: E402
 from robot.kinematic_tree import FINGER_CLOSED_RAD  # noqa: E402
 from robot.plan_sidecar import read_sidecar, sidecar_path  # noqa: E402
@@ -33,7 +33,7 @@ from robot.trajectory_file import read_trajectory  # noqa: E402
 def plan(tmp_path_factory):
     path = cached_reach_fixture(tmp_path_factory.getbasetemp())
     sc = read_sidecar(sidecar_path(path))
-    return read_trajectory(path, sc.rate_hz), sc, LadderSpec(**sc.ladder)
+    return read_trajectory(path, sc.rate_hz), sc, sidecar_ladder(sc, str(path))
 
 
 @pytest.fixture(scope="module")

@@ -18,8 +18,7 @@ from daemon.pwm import default_drc_gains  # noqa: E402
 from daemon.sim.board_model import BoardModel, PlacementError  # noqa: E402
 from execute.validate.plan_compare import compare_with_plan  # noqa: E402
 from execute.validate.simulate import SimulationOptions, simulate  # noqa: E402
-from ladders.loader import BUNDLED_LADDERS, load_ladder  # noqa: E402
-from ladders.spec import LadderSpec  # noqa: E402
+from ladders.loader import BUNDLED_LADDERS, load_ladder, sidecar_ladder  # noqa: E402
 from robot.errors import InputError  # noqa: E402
 from robot.joints import JOINT_INDEX, NUM_JOINTS  # noqa: E402
 from robot.plan_sidecar import read_sidecar, sidecar_path  # noqa: E402
@@ -49,7 +48,7 @@ def test_scene_steps_one_second_without_warnings(ladder):
 def plan(tmp_path_factory):
     path = cached_reach_fixture(tmp_path_factory.getbasetemp())
     sc = read_sidecar(sidecar_path(path))
-    return read_trajectory(path, sc.rate_hz), sc, LadderSpec(**sc.ladder)
+    return read_trajectory(path, sc.rate_hz), sc, sidecar_ladder(sc, str(path))
 
 
 def test_fixture_climbs_in_mixed_without_warnings(plan):

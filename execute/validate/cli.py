@@ -61,17 +61,10 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def ladder_from_sidecar(d: dict, where: str):
-    from ladders.loader import parse_ladder_yaml
-    from ladders.spec import LadderSpec
+    """The ladder spec of a sidecar's field ``ladder``, by the spec's own rules."""
+    from ladders.loader import ladder_from_mapping
 
-    if "geometry" in d:  # the YAML layout
-        import yaml
-
-        return parse_ladder_yaml(yaml.safe_dump(d), where)
-    try:
-        return LadderSpec(**d)
-    except TypeError as exc:
-        raise InputError(f"{where}: field 'ladder' is not a ladder spec: {exc}") from None
+    return ladder_from_mapping(d, where)
 
 
 def motion_config(args: argparse.Namespace):

@@ -50,13 +50,9 @@ def _read(path: Path, rate_hz: float, robot: str) -> np.ndarray:
 
 
 def _ladder(args, sidecar: PlanSidecar, where: str):
-    import yaml
+    from ladders.loader import load_ladder, sidecar_ladder
 
-    from ladders.loader import load_ladder, parse_ladder_yaml
-
-    if args.ladder:
-        return load_ladder(args.ladder)
-    return parse_ladder_yaml(yaml.safe_dump(sidecar.ladder), f"{where}: field 'ladder'")
+    return load_ladder(args.ladder) if args.ladder else sidecar_ladder(sidecar, where)
 
 
 def _verdict(r: CheckResult):
