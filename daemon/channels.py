@@ -39,22 +39,10 @@ Two implementations behind the one interface:
   - `cleanup_stale` removes channel files no live process has open (the daemon calls it
     at start-up).
 
-Why not iceoryx2 (0.10.0, the maintained IPC library the issue suggested), and why a
-futex? Measured with ``bench/bench_channels.py`` on the project VM (2 cores), two
-processes, the ``ref`` struct, write → blocked reader wakes, median / p99:
-
-| mechanism | measured |
-|---|---|
-| this module, futex wake (741 B) | 16.5–19 µs / 71–83 µs (5 runs; one outlier 29 / 181) |
-| this module, earlier: a UNIX datagram per waiting reader | 18.7–20 µs / 75–103 µs (*) |
-| iceoryx2 pub/sub + event service (421 B, earlier session) | 35.1 / 650 µs |
-| a bare futex wake with no data, two Python processes | 12.2–12.5 µs / 42–57 µs |
-| bare datagram, no data (the bench's OS floor) | 10–21 µs, varying with the VM's load |
-
-(*) the same 5 runs, interleaved with the futex ones; one outlier 29.8 / 101 µs.
-
-None meets the 11 µs median target on this machine: the bare wake-up alone takes
-12 µs here, and the rest (stamping, the 741-byte copies, the seqlock) is Python.
+Why a futex on a shared file and not an IPC library (iceoryx2) or a datagram per
+reader: it wakes a blocked reader fastest of the three measured, and needs nothing
+cleaned up after a crash. ``bench/bench_channels.py`` measures the wake-up latency; the
+figures and the comparison are in docs/decisions/channels.md.
 
 The seqlock assumes x86-64's store ordering (TSO); on weakly ordered CPUs (aarch64) the
 counter re-check needs real barriers. Do not fork a process that holds a channel open:

@@ -95,22 +95,15 @@ def shoulder_room_along_m(geom: LadderGeometry, params: RobotParams, rung: int,
 
 
 #: The feet's centre of pressure is kept this far inside the sole's support (the sole,
-#: or the part of it on a tread) [m]. The torque LP's optimum is a vertex: with the whole
-#: support it put the DRC feet's centres of pressure on rung 0's rear edge, and the left
-#: foot's 8–10 mm from the sole's side in the right foot's swing, where MuJoCo's sole
-#: rocked and the hands took the load the ankles did not give. The DRC mount alone
-#: (`--top-rung 0`), seeds 1–16, climbed in MuJoCo for 7 of 16 without the margin and
-#: for 15 of 16 with 2 cm (seed 6 lost a grip).
+#: or the part of it on a tread) [m]. The torque LP's optimum is a vertex, which puts a
+#: centre of pressure on the support's edge, where a real sole rocks and the hands take
+#: the load the ankles do not give (docs/decisions/foot-cop-margin.md).
 FOOT_COP_MARGIN_M = 0.02
 #: Share of the ladder's μ the planner lets a foot use. The torque LP's optimum puts a
-#: foot's friction on its cone (0.39–0.40 of μ = 0.4 on DRC seed 1's rung 0), and the
-#: load share the robot's compliance makes is not the LP's: in MuJoCo at the spec's
-#: μ = 0.4 the feet of DRC seed 5's plan slid forward on their rungs a few millimetres
-#: a step, the drift grew to 3 cm by rung 8 and a shin leaned on the rung above; at
-#: μ = 1 the same plan climbed, its feet within 1 cm of their holds. Planning to 3/4
-#: of μ is the usual margin of legged-robot planners, not a tuned figure (the first
-#: value tried); check-plan checks the whole μ. With it, seed 6 of seeds 1–8 climbs the
-#: whole DRC ladder in MuJoCo (none without); the feet still creep, less.
+#: foot's friction on its cone, and the load share the robot's compliance makes is not
+#: the LP's, so a foot planned on the cone slides. 3/4 of μ is the usual margin of
+#: legged-robot planners, not a tuned figure; check-plan checks the whole μ
+#: (docs/decisions/foot-friction-share.md).
 FOOT_FRICTION_SHARE = 0.75
 
 

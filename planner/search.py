@@ -95,12 +95,11 @@ class PlannerConfig:
     # Share of the ladder's μ a foot is planned to (planner.holds.FOOT_FRICTION_SHARE).
     foot_friction_share: float = FOOT_FRICTION_SHARE
     # The OMPL fallback (planner.paths.limb_rrt): RRTConnect's budget in collision checks
-    # (≈ 0.1 ms each; an arm through a steep ladder's rungs took up to 26,000), tried on
-    # at most this many samples of a step, as a failed search costs the whole budget, and
-    # only in the last samples before the step gives up. A pose whose arc collides sits
-    # near an obstacle, and later steps from there are harder: taken at the first failure
-    # DRC seeds 3 and 4 timed out at 120 s, after 10 failures seeds 7 and 10 (20/20
-    # without the fallback), while a ladder that needs the fallback fails every sample.
+    # (≈ 0.1 ms each; an arm through a steep ladder's rungs takes tens of thousands),
+    # tried on at most this many samples of a step, as a failed search costs the whole
+    # budget, and only in the last samples before the step gives up: a pose whose arc
+    # collides sits near an obstacle, and later steps from there are harder
+    # (docs/decisions/ompl-fallback.md).
     limb_rrt_max_checks: int = 30000
     limb_rrt_tries_per_step: int = 4
     limb_rrt_after_failures: int = 40

@@ -36,13 +36,9 @@ moves). `TrajectoryPlayer.feedforward_duty` turns them into hubo-ach's feed-forw
 (``pwm_command``) at the battery voltage the caller knows.
 
 A holding arm. An arm in PWM mode keeps hubo-ach's law while its hand holds the rail:
-its stiffness towards the reference (kp) plus the feed-forward. It was once sent in mode
-COMPLIANT (``f = pos``) there, the feed-forward alone, so that it would not fight a grip
-that squeezed the rail and could not turn on it. A hand turns on its rail
-(`daemon.sim.grasp_latch`), and an arm without stiffness had nothing to hold it in the pose
-the closed chain leaves free: on a DRC mount planned at 0.85 of the torque limits the left
-wrist pitch drifted 0.67 rad and the shoulder 0.34 rad off the plan, and the left knee's
-board tripped at 81.8 s.
+its stiffness towards the reference (kp) plus the feed-forward. The closed chain through
+the rail leaves the arm's pose free (a hand turns on its rail, `daemon.sim.grasp_latch`),
+and the stiffness is what holds it there (docs/decisions/arm-feedforward.md).
 """
 
 from __future__ import annotations

@@ -126,8 +126,7 @@ def contact_space_interpolate(kin: HuboKinematics, checker: FeasibilityChecker,
         if region is not None and not region.is_empty:
             # The CoM left the support region between two stable ends: project again,
             # pulling the CoM into the region as the ends were found. Only then: on every
-            # projection it also bent paths that were fine (the DRC seed 1 climb took
-            # 1486 s of motion instead of 1278 s).
+            # projection the pull also bends paths that were fine, and lengthens them.
             q_mid, verdict = project(q0, q1, span, qm, moving_targets,
                                      region.clockwise_vertices(), depth)
         if not verdict.ok:

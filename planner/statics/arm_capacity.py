@@ -37,14 +37,10 @@ __all__ = ["ARM_STRATEGIES", "BACK_EMF_SHARE", "DEFAULT_ARM_STRATEGY",
 ARM_STRATEGIES = ("mixed", "position")
 #: Share of its torque limit a joint in position mode (the legs, the waist, a rigid arm)
 #: is planned to. The torque LP chooses how the legs and the compliant arms share the
-#: load, but a compliant arm gives what its feed-forward and its stiffness towards the
-#: reference make, and a position-controlled leg takes the rest: at the DRC mount's
-#: lift-off the left hand pulled 48 N towards the ladder in MuJoCo where the LP had 61 N,
-#: and the left knee, planned at 0.96–0.99 of its limit, saturated and its board
-#: tripped. Of mount-only DRC plans (seeds 1–16), MuJoCo climbed 5 at 1.0 (10 of the 11
-#: failures knee trips) and 7 at 0.9 (no knee trip; 4 hip-roll trips and 5 grips lost);
-#: the reserve removes the knee's failure, not the others, and 7 against 5 of 16 is
-#: within chance. The value is a choice.
+#: load, but a compliant arm gives only what its feed-forward and its stiffness towards
+#: the reference make, and a position-controlled leg takes the rest: the reserve keeps
+#: that rest within the leg's limit. The value is a choice
+#: (docs/decisions/position-torque-share.md).
 DEFAULT_POSITION_TORQUE_SHARE = 0.9
 DEFAULT_ARM_STRATEGY = "mixed"
 #: Share of a compliant joint's PWM clamp its back-EMF may take while it moves: a PWM arm
@@ -69,11 +65,8 @@ def balance_stance(stance: Stance, strategy: str = DEFAULT_ARM_STRATEGY) -> Stan
 
     A hand whose arm is the only compliant one gripping carries load but does not hold
     the balance: the feet must. One PWM arm is a soft spring (its pull grows by the
-    reference error times kp), too soft against the body tipping about the feet's edge.
-    In MuJoCo, DRC seed 1's plan released the left hand on rung 0 with the CoM 9 mm
-    behind the rung's rear edge and the right hand planned to pull 10 N; the body tipped
-    back 10 cm in 2.4 s while that hand's pull grew from 6 to 33 N, until the grip let
-    go. Two compliant arms (the DRC mount, 15 of 16 seeds) and a rigid arm hold it.
+    reference error times kp), too soft against the body tipping about the feet's edge;
+    two compliant arms, or a rigid one, hold it (docs/decisions/balance-rule.md).
     """
     hands = [h for h in stance.holds if h.is_hand]
     feet = tuple(h for h in stance.holds if not h.is_hand)
