@@ -17,8 +17,8 @@ import numpy as np
 
 from ladders.spec import STRINGER_DEPTH_M, STRINGER_WIDTH_M, LadderSpec
 from robot.errors import InputError
+from robot.vocabulary import SIDES
 
-SIDES: tuple[str, str] = ("left", "right")
 _SIDE_SIGN = {"left": 1.0, "right": -1.0}  # left = +y_L
 
 

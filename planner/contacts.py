@@ -15,8 +15,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ladders.contact_model import FootPatch, HandLimits
+from robot.vocabulary import LIMBS, Limb  # noqa: F401  (LIMBS re-exported)
 
-LIMBS = ("left_hand", "right_hand", "left_foot", "right_foot")
 #: Operational frame of each limb in the robot model.
 LIMB_FRAME = {"left_hand": "L_palm", "right_hand": "R_palm", "left_foot": "L_sole",
               "right_foot": "R_sole"}
@@ -52,7 +52,7 @@ class Hold:
 
     @property
     def is_hand(self) -> bool:
-        return self.limb.endswith("hand")
+        return Limb(self.limb).is_hand
 
     def __repr__(self) -> str:
         p = self.T_world_frame[:3, 3]

@@ -40,6 +40,7 @@ from robot.plan_sidecar import (
     write_sidecar,
 )
 from robot.trajectory_file import write_trajectory
+from robot.vocabulary import SIDES, SegmentPhase
 
 if TYPE_CHECKING:
     from planner.contacts import Hold
@@ -59,7 +60,7 @@ CLEARANCE_EVERY_LINES = 20
 #: The arms' feed-forward torques are sampled every this-many lines (0.1 s at 200 Hz:
 #: a quasi-static climb's load shifts over seconds).
 FEEDFORWARD_EVERY_LINES = 20
-ARMS = ("left", "right")
+ARMS = SIDES
 
 
 @dataclass
@@ -136,7 +137,7 @@ def segment_paths(result: SearchResult, kin, q_start: np.ndarray | None = None,
         prev = configs[-1] if configs else prev
         q = np.array(configs)
         on_rail = [h.limb for h in seg.holds]
-        if seg.phase in ("grasp", "release"):
+        if seg.phase in (SegmentPhase.GRASP, SegmentPhase.RELEASE):
             on_rail += list(seg.moving_limbs)
         out.append(SegmentPath(f"{seg.step.label}/{seg.phase}",
                                np.array([kin.columns(c) for c in q]), q,
@@ -276,7 +277,7 @@ def _sidecar_segments(result: SearchResult, timed: TimedPlan,
         seg = result.segments[int(timed.segment_of_line[a])]
         if timed.dwell[a]:
             holds = after[step_of_segment[int(timed.segment_of_line[a])]]
-            phase, moving = "dwell", ()
+            phase, moving = SegmentPhase.DWELL, ()
         else:
             holds = {h.limb: h for h in seg.holds}
             phase, moving = seg.phase, tuple(seg.moving_limbs)

@@ -38,7 +38,13 @@ from primitives.primitive import Step
 from robot.errors import HuboLadderError, InputError
 from robot.joints import ARM_JOINTS, FINGER_JOINTS, LEG_JOINTS
 from robot.kinematic_tree import FINGER_CLOSED_RAD
-from robot.vocabulary import InterpolationFailure, Limb, RejectCause, StepFailure
+from robot.vocabulary import (
+    InterpolationFailure,
+    Limb,
+    RejectCause,
+    SegmentPhase,
+    StepFailure,
+)
 
 log = logging.getLogger(__name__)
 
@@ -456,7 +462,7 @@ class ClimbPlanner:
                                    f"no straightened pose: {_why(verdict)}")
             path = self._interp(q, q_new, stance.holds, stance, self._contacts(stance.holds),
                                 stats)
-            segments.append(PathSegment(step, "body", stance.holds, (), path))
+            segments.append(PathSegment(step, SegmentPhase.BODY, stance.holds, (), path))
             return segments, q_new, stance
 
         # 1. Lift-off configuration: every current hold kept, stable without the moving limbs.
@@ -475,7 +481,7 @@ class ClimbPlanner:
                 raise _StepRejected(StepFailure.NO_LIFT_OFF, f"no lift-off pose: {_why(verdict)}")
             self._remember(step, 0, q_lift)
             path = self._interp(q, q_lift, stance.holds, stance, contacts_all, stats)
-            segments.append(PathSegment(step, "body", stance.holds, (), path))
+            segments.append(PathSegment(step, SegmentPhase.BODY, stance.holds, (), path))
 
         # 2. Open the hands that let go.
         q_cur = q_lift
@@ -483,7 +489,8 @@ class ClimbPlanner:
             old = stance.hold(limb)
             if Limb(limb).is_hand and old is not None:
                 path = self._finger_path(q_cur, Limb(limb).side, 0.0)
-                segments.append(PathSegment(step, "release", support, moving_limbs, path))
+                segments.append(PathSegment(step, SegmentPhase.RELEASE, support, moving_limbs,
+                                            path))
                 q_cur = path[-1]
 
         # 3. Way-points of the moving limbs (moved together), then interpolation.
@@ -530,7 +537,7 @@ class ClimbPlanner:
                 limb_path += self._limb_detour(q_cur, q_next, moving_limbs, support,
                                                support_stance, contacts, stats, exc, attempt)
             q_cur = q_next
-        segments.append(PathSegment(step, "limb", support, moving_limbs, limb_path))
+        segments.append(PathSegment(step, SegmentPhase.LIMB, support, moving_limbs, limb_path))
 
         # 4. Polish: the new holds become hard tasks, met to solver precision, and the
         # placed configuration must be feasible in the new stance too.
@@ -559,8 +566,8 @@ class ClimbPlanner:
         for hold in new_holds:
             if hold.is_hand:
                 path = self._finger_path(q_cur, Limb(hold.limb).side, FINGER_CLOSED_RAD)
-                segments.append(PathSegment(step, "grasp", tuple(in_contact), (hold.limb,),
-                                            path))
+                segments.append(PathSegment(step, SegmentPhase.GRASP, tuple(in_contact),
+                                            (hold.limb,), path))
                 in_contact.append(hold)
                 q_cur = path[-1]
         stats.samples += fstats.attempts

@@ -25,7 +25,16 @@ import numpy as np
 
 from robot.errors import InputError
 from robot.joints import ARM_JOINTS, JOINT_NAMES
-from robot.vocabulary import ARM_MODES, LIMBS, HoldTarget, HoldTargetError, SegmentPhase, Side
+from robot.vocabulary import (
+    ARM_MODES,
+    LIMBS,
+    HoldTarget,
+    HoldTargetError,
+    HoldTargetKind,
+    Limb,
+    SegmentPhase,
+    Side,
+)
 
 FORMAT = "hubo-ladder-plan"
 VERSION = 2
@@ -80,8 +89,8 @@ def hand_holding_lines(segments: Sequence[Segment], line_count: int, arm: str) -
     """Lines on which the ``arm`` ("left"/"right") hand holds a rail, bool (line_count,)."""
     held = np.zeros(line_count, dtype=bool)
     for seg in segments:
-        hold = seg.holds.get(f"{arm}_hand")
-        if hold is not None and hold.target.startswith("rail"):
+        hold = seg.holds.get(Limb.hand(arm))
+        if hold is not None and hold.hold_target.kind is HoldTargetKind.RAIL:
             held[seg.first_line - 1:seg.last_line] = True
     return held
 

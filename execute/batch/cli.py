@@ -33,12 +33,13 @@ from pathlib import Path
 
 from robot.constants import DAEMON_RATE_HZ
 from robot.errors import HuboLadderError, InputError
+from robot.vocabulary import ArmStrategy
 
 __all__ = ["main", "parse_args"]
 
 log = logging.getLogger("batch-eval")
 
-STRATEGIES = ("mixed", "position", "pwm")
+STRATEGIES = tuple(ArmStrategy)
 LOOPS = ("closed", "open")
 MAX_SEEDS = 10_000
 MAX_WORKERS = 256

@@ -56,6 +56,7 @@ from robot.errors import HuboLadderError, InputError
 from robot.joints import ARM_JOINTS, NUM_JOINTS, joint_indices
 from robot.motors import MotorTable
 from robot.plan_sidecar import ArmFeedforward
+from robot.vocabulary import ARM_MODES, SIDES
 
 __all__ = [
     "ALLOWED_RATES_HZ",
@@ -74,8 +75,7 @@ __all__ = [
 
 #: Line rates hubo-read-trajectory accepted [Hz] (the thesis lists all but 500).
 ALLOWED_RATES_HZ = (10, 25, 50, 100, 200, 500)
-ARMS = ("left", "right")
-ARM_MODES = ("position", "pwm")
+ARMS = SIDES
 _EPS_LINES = 1e-9  # [lines] float slack so that t = k/f exactly lands on line k
 
 

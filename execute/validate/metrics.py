@@ -31,6 +31,7 @@ import mujoco
 import numpy as np
 
 from robot.joints import ARM_JOINTS, JOINT_NAMES, joint_indices
+from robot.vocabulary import HoldTargetKind
 
 __all__ = ["RunMetrics", "compute_metrics", "line_samples", "tracking_error_by_arm"]
 
@@ -140,7 +141,7 @@ def compute_metrics(run) -> RunMetrics:
                 drift = np.linalg.norm(lg.sole_m[ticks, s] - lg.sole_m[ticks[0], s], axis=1)
                 slip = max(slip, float(drift.max()))
     rungs = [seg.rung for seg in run.sidecar.segments
-             if any(h.target.startswith("rung_") for h in seg.holds.values())]
+             if any(h.hold_target.kind is HoldTargetKind.RUNG for h in seg.holds.values())]
     climbed = (max(rungs) + 1) if rungs else 0
     sim_s = float(run.simulated_s)
     return RunMetrics(

@@ -27,6 +27,7 @@ from ladders.contact_model import HandLimits
 from ladders.geometry import LadderGeometry
 from robot.joints import FINGER_JOINTS, JOINT_INDEX
 from robot.limits import joint_limits
+from robot.vocabulary import Limb
 
 __all__ = ["GripAgreement", "JointLoad", "PlanComparison", "compare_with_plan", "grip_agreement",
            "planned_torque_history"]
@@ -150,9 +151,9 @@ def grip_agreement(run, trajectory_rad: np.ndarray, ladder) -> tuple[GripAgreeme
     picks = []  # (segment, limb, line, time, force, torque)
     for k, seg in enumerate(run.sidecar.segments):
         for limb in seg.holds:
-            if not limb.endswith("hand"):
+            if not Limb(limb).is_hand:
                 continue
-            hist = run.board.latches[limb.removesuffix("_hand")].load_history
+            hist = run.board.latches[Limb(limb).side].load_history
             best = None
             mid = 0.5 * (seg.first_line + seg.last_line)
             for t, f, tq in hist:
@@ -224,8 +225,8 @@ def compare_with_plan(run, trajectory_rad: np.ndarray, ladder) -> PlanComparison
     loads.sort(key=lambda j: j.departure, reverse=True)
     holds: dict[str, tuple[np.ndarray, np.ndarray | None]] = {}
     for limb, f in plan.torque.forces_n.items():
-        side, part = limb.split("_")
-        if part == "hand":
+        side = Limb(limb).side
+        if Limb(limb).is_hand:
             latch = board.latches[side]
             sim = latch.grip_load()[0] if latch.latched else None
         else:

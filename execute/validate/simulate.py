@@ -44,12 +44,13 @@ from ladders.geometry import LadderGeometry
 from ladders.spec import LadderSpec
 from robot.errors import InputError
 from robot.plan_sidecar import PlanSidecar
+from robot.vocabulary import ArmStrategy, HoldTargetKind, Limb
 
 __all__ = ["STRATEGIES", "SimulationLog", "SimulationOptions", "SimulationRun", "simulate"]
 
 log = logging.getLogger(__name__)
 
-STRATEGIES = ("mixed", "position", "pwm")
+STRATEGIES = tuple(ArmStrategy)
 
 
 @dataclass(frozen=True)
@@ -201,8 +202,8 @@ def simulate(trajectory_rad: np.ndarray, sidecar: PlanSidecar, ladder: LadderSpe
     first = sidecar.segments[0] if sidecar.segments else None
     soles = None
     if first is not None:
-        soles = {k.split("_")[0]: np.asarray(h.position_m) for k, h in first.holds.items()
-                 if k.endswith("_foot") and h.target == "floor"}
+        soles = {Limb(k).side.value: np.asarray(h.position_m) for k, h in first.holds.items()
+                 if Limb(k).is_foot and h.hold_target.kind is HoldTargetKind.FLOOR}
     board.reset(trajectory_rad[0], soles or None)
     schedule, compliant = _schedule(opt.strategy, sidecar, n)
     rate = int(round(sidecar.rate_hz))

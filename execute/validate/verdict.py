@@ -31,6 +31,7 @@ import numpy as np
 
 from robot.constants import GRAVITY_M_S2
 from robot.plan_sidecar import HoldRecord, PlanSidecar
+from robot.vocabulary import HoldTargetKind, Limb
 
 __all__ = ["Failure", "Verdict", "VerdictConfig", "VerdictMonitor", "default_config"]
 
@@ -78,10 +79,6 @@ class Verdict:
         return f"Verdict(failed: {f.cause} at t = {f.time_s:.2f} s, line {f.line}: {f.why})"
 
 
-def _limb_side(limb: str) -> str:
-    return limb.split("_")[0]
-
-
 class VerdictMonitor:
     """Applies the checks to a `daemon.sim.board_model.BoardModel` as it runs.
 
@@ -125,11 +122,11 @@ class VerdictMonitor:
         return self.T_err[:3, :3] @ p + self.T_err[:3, 3]
 
     def _sole(self, limb: str) -> np.ndarray:
-        return self.data.site(f"{_limb_side(limb)[0].upper()}_sole").xpos.copy()
+        return self.data.site(f"{Limb(limb).side[0].upper()}_sole").xpos.copy()
 
     def _touching(self, limb: str, target: str) -> bool:
         m, d = self.model, self.data
-        side = _limb_side(limb)[0].upper()
+        side = Limb(limb).side[0].upper()
         body = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, f"{side}_foot")
         for i in range(d.ncon):
             c = d.contact[i]
@@ -184,7 +181,7 @@ class VerdictMonitor:
             self._segment_entry = (seg.first_line, time_s)  # played lines, pauses counted
         if time_s - self._segment_entry[1] >= self.config.latch_grace_s:
             for limb, hold in seg.holds.items():
-                if not (limb.endswith("_hand") and hold.target.startswith("rail")):
+                if not (Limb(limb).is_hand and hold.hold_target.kind is HoldTargetKind.RAIL):
                     continue
                 f = self._latch_failure(limb, hold, time_s, line)
                 if f is not None:
@@ -193,7 +190,7 @@ class VerdictMonitor:
 
     def _latch_failure(self, limb: str, hold: HoldRecord, time_s: float,
                        line: int) -> Failure | None:
-        latch = self.board.latches[_limb_side(limb)]
+        latch = self.board.latches[Limb(limb).side]
         if latch.latched and latch.rail == hold.target:
             return None
         dist, ang = latch.palm_to_rails()[hold.target]
@@ -201,12 +198,12 @@ class VerdictMonitor:
         palm = self.data.site_xpos[latch.palm_site]
         miss = float(np.linalg.norm(palm - planned))
         state = latch.state.value
-        why = (f"{_limb_side(limb)} hand is {state}, not latched on {hold.target}: palm "
+        why = (f"{Limb(limb).side} hand is {state}, not latched on {hold.target}: palm "
                f"{dist * 100:.1f} cm from the rail axis (tolerance "
                f"{latch.config.position_tolerance_m * 100:.0f} cm), grip axis "
                f"{math.degrees(ang):.0f}° off, {miss * 100:.1f} cm from the planned grasp")
         return Failure("grasp_not_latched", time_s, line, why,
-                       {"hand": _limb_side(limb), "rail": hold.target,
+                       {"hand": Limb(limb).side, "rail": hold.target,
                         "palm_to_axis_m": dist, "grip_angle_deg": math.degrees(ang),
                         "palm_to_plan_m": miss, "hand_state": state})
 
@@ -240,7 +237,7 @@ class VerdictMonitor:
         status: dict[str, str] = {}
         for limb, hold in self.sidecar.final_holds.items():
             if limb.endswith("_hand"):
-                latch = self.board.latches[_limb_side(limb)]
+                latch = self.board.latches[Limb(limb).side]
                 if latch.latched and latch.rail == hold.target:
                     status[limb] = "ok"
                 else:

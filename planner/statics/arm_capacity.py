@@ -27,6 +27,7 @@ from planner.contacts import Stance
 from robot.joints import ARM_JOINTS, JOINT_INDEX
 from robot.motors import DEFAULT_BATTERY_V, motor_table
 from robot.pwm_gains import safe_default_gain_table
+from robot.vocabulary import ArmStrategy
 
 __all__ = ["ARM_STRATEGIES", "BACK_EMF_SHARE", "DEFAULT_ARM_STRATEGY",
            "DEFAULT_POSITION_TORQUE_SHARE",
@@ -34,7 +35,8 @@ __all__ = ["ARM_STRATEGIES", "BACK_EMF_SHARE", "DEFAULT_ARM_STRATEGY",
            "compliant_torque_nm",
            "gripping_sides", "gripping_torque_limits", "gripping_velocity_limits"]
 
-ARM_STRATEGIES = ("mixed", "position")
+#: The strategies the planner plans for (a PWM-only climb is not planned).
+ARM_STRATEGIES = (ArmStrategy.MIXED, ArmStrategy.POSITION)
 #: Share of its torque limit a joint in position mode (the legs, the waist, a rigid arm)
 #: is planned to. The torque LP chooses how the legs and the compliant arms share the
 #: load, but a compliant arm gives only what its feed-forward and its stiffness towards

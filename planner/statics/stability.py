@@ -43,6 +43,7 @@ from ladders.contact_model import FootPatch, HandLimits
 from planner.contacts import LIMB_FRAME, Hold, Stance
 from robot.constants import GRAVITY_M_S2
 from robot.errors import HuboLadderError
+from robot.vocabulary import Limb
 
 log = logging.getLogger(__name__)
 
@@ -601,7 +602,7 @@ class TorqueCheck:
         ``hands_only``); ("", "", 0) if none."""
         best = ("", "", 0.0)
         for limb, use in self.contact_use.items():
-            if hands_only and not limb.endswith("hand"):
+            if hands_only and not Limb(limb).is_hand:
                 continue
             for load, u in use.items():
                 if u > best[2]:

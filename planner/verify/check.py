@@ -48,6 +48,7 @@ from planner.holds import foot_patch, half_tread_m
 from planner.statics.arm_capacity import balance_stance, gripping_sides, gripping_torque_limits
 from robot.errors import InputError
 from robot.plan_sidecar import PlanSidecar, Segment
+from robot.vocabulary import HoldTarget, HoldTargetKind, Limb
 
 if TYPE_CHECKING:
     from planner.contacts import Hold, Stance
@@ -151,7 +152,7 @@ def contact_hold(spec, geom, params, limb: str, record) -> Hold:
     up = np.array([0.0, 0.0, 1.0])
     T = np.eye(4)
     T[:3, 3] = p
-    if limb.endswith("hand"):
+    if Limb(limb).is_hand:
         towards = geom.R_world_ladder[:, 0]
         return Hold(limb, record.target, T, np.vstack([p, p]), np.vstack([up, towards]), mu,
                     limits=hand_limits(mu, spec.rail_radius_m, geom.ladder_direction))
@@ -159,8 +160,9 @@ def contact_hold(spec, geom, params, limb: str, record) -> Hold:
     T[:3, :3] = R
     hl = params.foot_length_m / 2
     x_range = (-hl, hl)
-    if record.target.startswith("rung_"):
-        top = geom.rung_top_centres_m[int(record.target.removeprefix("rung_"))]
+    target = record.hold_target
+    if target.kind is HoldTargetKind.RUNG:
+        top = geom.rung_top_centres_m[target.rung]
         # Tread centre along the sole's x axis, relative to the sole frame.
         c = float(R[:, 0] @ (top - p))
         x_range = sole_patch_x(spec.rung_shape, half_tread_m(spec), c, params.foot_length_m)
@@ -273,24 +275,21 @@ class _Verifier:
 
     # ---------------------------------------------------------------- holds
     def target_distance(self, target: str, p: np.ndarray) -> float:
-        """How far a recorded hold position lies from its object [m]."""
-        if target == "floor":
+        """How far a recorded hold position lies from its object [m]; raises
+        `robot.vocabulary.HoldTargetError` (bad input) for a target that names none."""
+        hold = HoldTarget.parse(target)
+        if hold.kind is HoldTargetKind.FLOOR:
             return abs(float(p[2]))
-        if target.startswith("rail_"):
-            side = target.removeprefix("rail_")
-            return float(np.linalg.norm(p - self.geom.closest_rail_point(side, p)))
-        if target.startswith("rung_"):
-            i = int(target.removeprefix("rung_"))
-            s = self.spec
-            top = self.geom.to_ladder(self.geom.rung_top_centres_m[i])
-            d = self.geom.to_ladder(p) - top
-            # The sole overlaps the tread: its centre within half a foot of the tread.
-            half_along = half_tread_m(s) + self.params.foot_length_m / 2
-            excess = np.array([max(0.0, abs(d[0]) - half_along),
-                               max(0.0, abs(d[1]) - s.rung_width_m / 2), d[2]])
-            return float(np.linalg.norm(excess))
-        raise InputError(f"hold target {target!r} is not 'floor', 'rung_<i>' or "
-                         "'rail_left'/'rail_right'")
+        if hold.kind is HoldTargetKind.RAIL:
+            return float(np.linalg.norm(p - self.geom.closest_rail_point(hold.side, p)))
+        s = self.spec  # a rung
+        top = self.geom.to_ladder(self.geom.rung_top_centres_m[hold.rung])
+        d = self.geom.to_ladder(p) - top
+        # The sole overlaps the tread: its centre within half a foot of the tread.
+        half_along = half_tread_m(s) + self.params.foot_length_m / 2
+        excess = np.array([max(0.0, abs(d[0]) - half_along),
+                           max(0.0, abs(d[1]) - s.rung_width_m / 2), d[2]])
+        return float(np.linalg.norm(excess))
 
     def frame_position(self, limb: str) -> np.ndarray:
         return self.data.oMf[self.frame_id[limb]].translation.copy()
