@@ -67,12 +67,12 @@ def _joints(text: str | None) -> list[int]:
 
 
 def _run(args) -> int:
-    from rich.console import Console
     from rich.live import Live
 
     from daemon.channels import open_channel
     from daemon.state_log import StateLogWriter
     from daemon.structs import STATE_DTYPE
+    from robot.text_console import text_console
 
     joints = _joints(args.joints)
     if not args.refresh > 0:
@@ -82,7 +82,7 @@ def _run(args) -> int:
     if s is None or time.monotonic_ns() - int(s["time_ns"]) > 500_000_000:
         state.close()
         raise HuboLadderError(f"no hubo-daemon is ticking on instance {args.instance!r}")
-    console = Console(stderr=False)
+    console = text_console()
     if args.once:
         console.print(state_table(s, joints))
         state.close()

@@ -69,10 +69,10 @@ def side_view_png(spec: LadderSpec, path: Path) -> Path:
 
 
 def _show(args: argparse.Namespace) -> int:
-    from rich.console import Console
     from rich.table import Table
 
     from ladders.mesh import export_ladder_mesh
+    from robot.text_console import text_console
 
     spec = load_ladder(args.ladder)
     table = Table(title=f"ladder {spec.name}")
@@ -80,7 +80,7 @@ def _show(args: argparse.Namespace) -> int:
         table.add_column(col)
     for row in parameter_rows(spec):
         table.add_row(*row)
-    console = Console()
+    console = text_console()  # spec names and paths verbatim
     console.print(table)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)

@@ -129,7 +129,6 @@ def _summary_table(result, total_s: float, out) -> object:
 
 
 def _plan(args: argparse.Namespace, err) -> int:
-    from rich.console import Console
     from rich.progress import (
         BarColumn,
         MofNCompleteColumn,
@@ -143,6 +142,7 @@ def _plan(args: argparse.Namespace, err) -> int:
     from planner.search import ClimbPlanner, PlannerConfig, PlanningFailed
     from planner.time_limit import HARD_LIMIT_GRACE_S, TimeLimitExceeded, hard_time_limit
     from primitives.library import climb_sequence
+    from robot.text_console import text_console
 
     t0 = time.perf_counter()
     spec = load_ladder(args.ladder)
@@ -204,9 +204,9 @@ def _plan(args: argparse.Namespace, err) -> int:
             log.info("wrote %s", strip)
         except RenderingUnavailable as exc:
             err.print(f"plan-ladder: no snapshot strip: {exc}", markup=False)
-    console = Console()
+    console = text_console()
     if not console.is_terminal:  # a log file or a pipe: keep each row on one line
-        console = Console(width=200)
+        console = text_console(width=200)
     console.print(_summary_table(result, time.perf_counter() - t0, out))
     err.print(f"wrote {out.traj_path} and {out.sidecar_path}", highlight=False, soft_wrap=True)
     return 0
@@ -214,8 +214,9 @@ def _plan(args: argparse.Namespace, err) -> int:
 
 def main(argv: list[str] | None = None) -> int:
     """Entry point of ``plan-ladder``; returns the exit code."""
-    from rich.console import Console
     from rich.logging import RichHandler
+
+    from robot.text_console import text_console
 
     try:
         args = _parser().parse_args(argv)
@@ -223,7 +224,7 @@ def main(argv: list[str] | None = None) -> int:
         return int(exc.code or 0)
     if args.plots:
         os.environ.setdefault("MUJOCO_GL", "egl")  # headless, before mujoco is imported
-    err = Console(stderr=True)
+    err = text_console(stderr=True)  # messages carry names and file:line:col verbatim
     level = (logging.WARNING, logging.INFO, logging.DEBUG)[min(args.verbose, 2)]
     logging.basicConfig(level=level, format="%(name)s: %(message)s",
                         handlers=[RichHandler(console=err, show_time=False)], force=True)

@@ -278,7 +278,9 @@ def main(argv: list[str] | None = None) -> int:
     """Entry point of ``batch-eval``; returns the exit code."""
     from rich.console import Console
 
-    err = Console(stderr=True)
+    from robot.text_console import text_console
+
+    err = text_console(stderr=True)  # messages carry file names and file:line:col verbatim
     try:
         opts = parse_args(argv)
     except SystemExit as exc:  # argparse: --help (0) or a bad option (2)
