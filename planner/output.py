@@ -27,6 +27,7 @@ import numpy as np
 import pinocchio as pin
 
 from planner.statics.arm_capacity import DEFAULT_ARM_STRATEGY, arms_comply_while_gripping
+from planner.verify.check import CLEARANCE_EVERY_LINES  # the verifier's sampling
 from robot.constants import DAEMON_RATE_HZ
 from robot.joints import ARM_JOINTS
 from robot.plan_sidecar import (
@@ -55,8 +56,6 @@ __all__ = ["PWM_RAIL_DISTANCE_M", "PlanOutput", "arm_mode_runs", "held_palm_turn
 
 #: An arm is compliant (PWM) while its palm is this close to its rail's axis [m].
 PWM_RAIL_DISTANCE_M = 0.03
-#: Clearance is measured on every this-many-th line (a distance query is slow).
-CLEARANCE_EVERY_LINES = 20
 #: The arms' feed-forward torques are sampled every this-many lines (0.1 s at 200 Hz:
 #: a quasi-static climb's load shifts over seconds).
 FEEDFORWARD_EVERY_LINES = 20

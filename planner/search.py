@@ -440,63 +440,99 @@ class ClimbPlanner:
     def try_step(self, step: Step, q: np.ndarray, stance: Stance, radius_m: float,
                  stats: StepStats, attempt: int = 0
                  ) -> tuple[list[PathSegment], np.ndarray, Stance]:
-        """One sample of a step; raises `InterpolationError`/`_StepRejected` on failure."""
-        prim = step.primitive
-        moving_limbs = prim.moving_limbs
+        """One sample of a step; raises `InterpolationError`/`_StepRejected` on failure.
+
+        A step lifts off (every hold kept, the body made stable without the moving limbs),
+        opens the hands that let go, carries the moving limbs through their way-points,
+        places them exactly on their new holds and closes the hands that arrived on a
+        rail. A step without moving limbs (straighten) only moves the body."""
+        moving_limbs = step.primitive.moving_limbs
         support = tuple(h for h in stance.holds if h.limb not in moving_limbs)
-        support_stance = Stance(support)
         new_holds = tuple(self._sample_hold(seed, radius_m, q, attempt)
                           for seed in step.new_holds)
         next_stance = Stance(support + new_holds)
         fstats = FeasibleSearchStats()
-        segments: list[PathSegment] = []
+        if not moving_limbs:
+            return self._straighten(step, q, stance, stats, fstats)
+        segments, q_cur, pelvis = self._lift_off(step, q, stance, support, stats, fstats,
+                                                 attempt)
+        opening, q_cur = self._open_hands(step, q_cur, stance, support)
+        segments += opening
+        limb_path, q_cur = self._carry(step, q_cur, stance, support, new_holds, pelvis, stats,
+                                       fstats, attempt)
+        segments.append(PathSegment(step, SegmentPhase.LIMB, support, moving_limbs, limb_path))
+        q_cur = self._place(q_cur, next_stance, limb_path)
+        closing, q_cur = self._close_hands(step, q_cur, support, new_holds)
+        segments += closing
+        stats.samples += fstats.attempts
+        for k, v in (fstats.rejections or {}).items():
+            stats.failures[k] = stats.failures.get(k, 0) + v
+        return segments, q_cur, next_stance
 
-        if not moving_limbs:  # straighten: every hold kept, the body rises
-            pelvis = self._pelvis_target(step, stance.holds)
-            target = self._target(step, stance.holds, (), stance, self._contacts(stance.holds),
-                                  pelvis, q=q)
-            q_new, verdict = find_feasible(self.kin, self.checker, q, target, self.rng,
-                                           attempts=self.config.feasible_attempts, stats=fstats)
-            if q_new is None:
-                raise _StepRejected(StepFailure.NO_STRAIGHT_POSE,
-                                   f"no straightened pose: {_why(verdict)}")
-            path = self._interp(q, q_new, stance.holds, stance, self._contacts(stance.holds),
-                                stats)
-            segments.append(PathSegment(step, SegmentPhase.BODY, stance.holds, (), path))
-            return segments, q_new, stance
+    def _straighten(self, step: Step, q: np.ndarray, stance: Stance, stats: StepStats,
+                    fstats: FeasibleSearchStats
+                    ) -> tuple[list[PathSegment], np.ndarray, Stance]:
+        """Every hold kept, the body rises to a feasible pose."""
+        pelvis = self._pelvis_target(step, stance.holds)
+        target = self._target(step, stance.holds, (), stance, self._contacts(stance.holds),
+                              pelvis, q=q)
+        q_new, verdict = find_feasible(self.kin, self.checker, q, target, self.rng,
+                                       attempts=self.config.feasible_attempts, stats=fstats)
+        if q_new is None:
+            raise _StepRejected(StepFailure.NO_STRAIGHT_POSE,
+                               f"no straightened pose: {_why(verdict)}")
+        path = self._interp(q, q_new, stance.holds, stance, self._contacts(stance.holds),
+                            stats)
+        return [PathSegment(step, SegmentPhase.BODY, stance.holds, (), path)], q_new, stance
 
-        # 1. Lift-off configuration: every current hold kept, stable without the moving limbs.
+    def _lift_off(self, step: Step, q: np.ndarray, stance: Stance, support: tuple[Hold, ...],
+                  stats: StepStats, fstats: FeasibleSearchStats, attempt: int
+                  ) -> tuple[list[PathSegment], np.ndarray, np.ndarray | None]:
+        """The lift-off configuration: every current hold kept, stable without the moving
+        limbs (``q`` itself when it already is). Returns the body's path there, the
+        configuration and the step's pelvis target."""
+        support_stance = Stance(support)
         contacts_all = self._contacts(stance.holds)
         pelvis = self._pelvis_target(step, support)
         lift_target = self._target(step, stance.holds, (), support_stance, contacts_all, pelvis,
                                    q=q)
         verdict = self.checker.check(q, support_stance, contacts_all)
         if verdict.ok:
-            q_lift = q
-        else:
-            q_lift, verdict = find_feasible(self.kin, self.checker, q, lift_target, self.rng,
-                                            attempts=self.config.feasible_attempts,
-                                            stats=fstats, q_hint=self._hint(step, 0, attempt))
-            if q_lift is None:
-                raise _StepRejected(StepFailure.NO_LIFT_OFF, f"no lift-off pose: {_why(verdict)}")
-            self._remember(step, 0, q_lift)
-            path = self._interp(q, q_lift, stance.holds, stance, contacts_all, stats)
-            segments.append(PathSegment(step, SegmentPhase.BODY, stance.holds, (), path))
+            return [], q, pelvis
+        q_lift, verdict = find_feasible(self.kin, self.checker, q, lift_target, self.rng,
+                                        attempts=self.config.feasible_attempts,
+                                        stats=fstats, q_hint=self._hint(step, 0, attempt))
+        if q_lift is None:
+            raise _StepRejected(StepFailure.NO_LIFT_OFF, f"no lift-off pose: {_why(verdict)}")
+        self._remember(step, 0, q_lift)
+        path = self._interp(q, q_lift, stance.holds, stance, contacts_all, stats)
+        return [PathSegment(step, SegmentPhase.BODY, stance.holds, (), path)], q_lift, pelvis
 
-        # 2. Open the hands that let go.
-        q_cur = q_lift
+    def _open_hands(self, step: Step, q: np.ndarray, stance: Stance,
+                    support: tuple[Hold, ...]) -> tuple[list[PathSegment], np.ndarray]:
+        """The fingers of the moving hands that held a rail open, one hand after the other."""
+        segments = []
+        moving_limbs = step.primitive.moving_limbs
         for limb in moving_limbs:
-            old = stance.hold(limb)
-            if Limb(limb).is_hand and old is not None:
-                path = self._finger_path(q_cur, Limb(limb).side, 0.0)
+            if Limb(limb).is_hand and stance.hold(limb) is not None:
+                path = self._finger_path(q, Limb(limb).side, 0.0)
                 segments.append(PathSegment(step, SegmentPhase.RELEASE, support, moving_limbs,
                                             path))
-                q_cur = path[-1]
+                q = path[-1]
+        return segments, q
 
-        # 3. Way-points of the moving limbs (moved together), then interpolation.
+    def _carry(self, step: Step, q: np.ndarray, stance: Stance, support: tuple[Hold, ...],
+               new_holds: tuple[Hold, ...], pelvis: np.ndarray | None, stats: StepStats,
+               fstats: FeasibleSearchStats, attempt: int
+               ) -> tuple[list[np.ndarray], np.ndarray]:
+        """The moving limbs carried together through their way-points to their new holds
+        (a feasible configuration per way-point, contact-space interpolation between them,
+        the OMPL detour where that collides). Returns the path and where it ends."""
+        prim = step.primitive
+        support_stance = Stance(support)
         way = {}
         for hold in new_holds:
-            T_from = self.kin.frame_pose(q_cur, hold.frame)
+            T_from = self.kin.frame_pose(q, hold.frame)
             old = stance.hold(hold.limb)
             if hold.is_hand:
                 way[hold.limb] = hand_waypoints(T_from, hold, self.geom, prim.waypoints,
@@ -509,12 +545,13 @@ class ClimbPlanner:
             w.extend([w[-1]] * (n_way - len(w)))
         contacts_support = self._contacts(support)
         limb_path: list[np.ndarray] = []
+        q_cur = q
         for i in range(1, n_way):
             targets = tuple(Hold(h.limb, h.target, way[h.limb][i], h.points_m, h.normals,
                                  h.friction) for h in new_holds)
             contacts = dict(contacts_support)
             if i == 1:  # leaving: may still touch the old hold's object
-                contacts.update({lb: stance.hold(lb).target for lb in moving_limbs
+                contacts.update({lb: stance.hold(lb).target for lb in prim.moving_limbs
                                  if stance.hold(lb) is not None})
             if i == n_way - 1:  # arriving
                 contacts.update({h.limb: h.target for h in new_holds})
@@ -534,46 +571,52 @@ class ClimbPlanner:
                 limb_path += self._interp(q_cur, q_next, support, support_stance, contacts,
                                           stats, moving=targets)
             except InterpolationError as exc:
-                limb_path += self._limb_detour(q_cur, q_next, moving_limbs, support,
+                limb_path += self._limb_detour(q_cur, q_next, prim.moving_limbs, support,
                                                support_stance, contacts, stats, exc, attempt)
             q_cur = q_next
-        segments.append(PathSegment(step, SegmentPhase.LIMB, support, moving_limbs, limb_path))
+        return limb_path, q_cur
 
-        # 4. Polish: the new holds become hard tasks, met to solver precision, and the
-        # placed configuration must be feasible in the new stance too.
-        # The posture task pins the other joints where they are: near a singular or
-        # limit-bound pose a millimetre of hold error can otherwise swing them far.
-        polished = solve_ik(self.kin, q_cur, next_stance.holds, config=self.ik_config,
-                            posture_rad=self.kin.posture(q_cur), preferences=False)
+    def _place(self, q: np.ndarray, next_stance: Stance, limb_path: list[np.ndarray]
+               ) -> np.ndarray:
+        """Polish: the new holds become hard tasks, met to solver precision, and the placed
+        configuration must be feasible in the new stance too. The short move there is
+        appended to ``limb_path``; returns the placed configuration.
+
+        The posture task pins the other joints where they are: near a singular or
+        limit-bound pose a millimetre of hold error can otherwise swing them far."""
+        polished = solve_ik(self.kin, q, next_stance.holds, config=self.ik_config,
+                            posture_rad=self.kin.posture(q), preferences=False)
         if not polished.converged:
             raise _StepRejected(StepFailure.HOLDS_NOT_MET,
                                f"placed pose does not meet its holds: {polished!r}")
-        correction = self.kin.joint_distance(polished.q, q_cur)
+        correction = self.kin.joint_distance(polished.q, q)
         if correction > POLISH_MAX_RAD:
             raise _StepRejected(StepFailure.POLISH_TOO_FAR,
                                f"placing the holds exactly moves a joint {correction:.3f} rad")
         n = int(np.ceil(correction / self.config.resolution_rad))
-        limb_path += [self.kin.interpolate(q_cur, polished.q, (k + 1) / n) for k in range(n)]
-        q_cur = polished.q
-        verdict = self.checker.check(q_cur, next_stance, self._contacts(next_stance.holds))
+        limb_path += [self.kin.interpolate(q, polished.q, (k + 1) / n) for k in range(n)]
+        verdict = self.checker.check(polished.q, next_stance,
+                                     self._contacts(next_stance.holds))
         if not verdict.ok:
             raise _StepRejected(StepFailure.UNSTABLE_PLACED,
                                f"placed pose unstable in the new stance: {verdict.reason}")
+        return polished.q
 
-        # 5. Close the hands that arrived on a rail. A closing hand is not a hold yet: it
-        # joins the holds in contact once its fingers are closed.
+    def _close_hands(self, step: Step, q: np.ndarray, support: tuple[Hold, ...],
+                     new_holds: tuple[Hold, ...]) -> tuple[list[PathSegment], np.ndarray]:
+        """The fingers of the hands that arrived on a rail close, one hand after the other.
+        A closing hand is not a hold yet: it joins the holds in contact once its fingers
+        are closed."""
+        segments = []
         in_contact = list(support) + [h for h in new_holds if not h.is_hand]
         for hold in new_holds:
             if hold.is_hand:
-                path = self._finger_path(q_cur, Limb(hold.limb).side, FINGER_CLOSED_RAD)
+                path = self._finger_path(q, Limb(hold.limb).side, FINGER_CLOSED_RAD)
                 segments.append(PathSegment(step, SegmentPhase.GRASP, tuple(in_contact),
                                             (hold.limb,), path))
                 in_contact.append(hold)
-                q_cur = path[-1]
-        stats.samples += fstats.attempts
-        for k, v in (fstats.rejections or {}).items():
-            stats.failures[k] = stats.failures.get(k, 0) + v
-        return segments, q_cur, next_stance
+                q = path[-1]
+        return segments, q
 
     # ----------------------------------------------------------------------------------
     def plan(self, top_rung: int | None = None,

@@ -54,7 +54,8 @@ if TYPE_CHECKING:
     from planner.contacts import Hold, Stance
     from planner.statics.stability import SupportRegion, TorqueCheck
 
-__all__ = ["CHECKS", "CheckResult", "ContactLoad", "HOLD_TOL_M", "PlannedLoad",
+__all__ = ["CHECKS", "CLEARANCE_EVERY_LINES", "CheckResult", "ContactLoad", "HOLD_TOL_M",
+           "PlannedLoad",
            "allowed_contacts", "check_plan", "contact_hold", "contact_wrench_utilisation",
            "planned_loads"]
 
@@ -64,7 +65,8 @@ log = logging.getLogger(__name__)
 HOLD_TOL_M = 0.01
 #: Slack on joint limits for values written by a float formatter [rad].
 LIMIT_TOL_RAD = 1e-9
-#: Clearance (a slow distance query) is measured on every this-many-th line.
+#: Clearance (a slow distance query) is measured on every this-many-th line, by check-plan
+#: and for the plan's own clearance metric (planner.output), so the two compare.
 CLEARANCE_EVERY_LINES = 20
 CHECKS = ("joint limits", "velocity", "holds", "collision", "stability margin",
           "torque ratio", "contact wrench")
@@ -393,8 +395,6 @@ def check_plan(traj_rad: np.ndarray, sidecar: PlanSidecar, spec, robot: str | No
     Raises:
         InputError: the sidecar and the trajectory disagree (line count, coverage).
     """
-    from planner.statics.stability import check_stability, torque_feasibility
-    from robot.joints import JOINT_NAMES
     from robot.limits import joint_limits
 
     robot = robot or sidecar.robot
@@ -409,7 +409,35 @@ def check_plan(traj_rad: np.ndarray, sidecar: PlanSidecar, spec, robot: str | No
     seg_of = _segment_of_lines(sidecar, where)
     segs = sidecar.segments
     v = _Verifier(spec, robot, arm_strategy)
-    lim = joint_limits(robot)
+    res = _new_results()
+    _check_limits_and_speed(res, traj_rad, joint_limits(robot), rate_hz)
+
+    # Per line: base from a foot, holds, collisions, stability.
+    prev_key = None
+    prev_out: _Statics | None = None
+    for k in range(n):
+        line = k + 1
+        si = int(seg_of[k])
+        seg = segs[si]
+        label = f"{seg.primitive}/{seg.phase}"
+        q = v.configuration(traj_rad[k], seg)
+        if q is None:
+            res["holds"].offer(line, math.inf, math.inf, f"{label}: no foot in contact: the "
+                               "base cannot be placed", True)
+            continue
+        _check_holds(res["holds"], v, line, seg, label)
+        at_end = line in (seg.first_line, seg.last_line)
+        if every > 1 and (line - seg.first_line) % every and not at_end:
+            continue
+        key = (si, traj_rad[k].tobytes())
+        if key != prev_key or prev_out is None:  # else a dwell line: the same as before
+            prev_key, prev_out = key, _statics_at(v, q, segs, si, line)
+        _offer_statics(res, line, label, prev_out, v.stance(si, seg).balance_limbs)
+    return [res[c] for c in CHECKS]
+
+
+def _new_results() -> dict[str, CheckResult]:
+    """An empty result per check, with its limit and unit."""
     res = {c: CheckResult(c) for c in CHECKS}
     res["joint limits"].limit, res["joint limits"].unit = 0.0, "rad past limit"
     res["velocity"].limit, res["velocity"].unit = 1.0, "× nominal"
@@ -418,8 +446,15 @@ def check_plan(traj_rad: np.ndarray, sidecar: PlanSidecar, spec, robot: str | No
     res["stability margin"].limit, res["stability margin"].unit = 0.0, "m"
     res["torque ratio"].limit, res["torque ratio"].unit = 1.0, "× limit"
     res["contact wrench"].limit, res["contact wrench"].unit = 1.0, "× limit"
+    return res
 
-    # Joint limits and speeds: whole-array checks.
+
+def _check_limits_and_speed(res: dict[str, CheckResult], traj_rad: np.ndarray, lim,
+                            rate_hz: float) -> None:
+    """Joint limits and joint speeds between lines: whole-array checks."""
+    from robot.joints import JOINT_NAMES
+
+    n = len(traj_rad)
     beyond = np.maximum(lim.lower_rad - traj_rad, traj_rad - lim.upper_rad)
     # The worst line, then every failing line, each once (the worst is usually among them).
     for k in dict.fromkeys(np.argsort(-beyond.max(axis=1))[:1].tolist()
@@ -443,72 +478,80 @@ def check_plan(traj_rad: np.ndarray, sidecar: PlanSidecar, spec, robot: str | No
     else:
         res["velocity"].value = 0.0
 
-    # Per line: base from a foot, holds, collisions, stability.
-    prev_key = None
-    prev_out: tuple | None = None
-    for k in range(n):
-        line = k + 1
-        si = int(seg_of[k])
-        seg = segs[si]
-        label = f"{seg.primitive}/{seg.phase}"
-        q = v.configuration(traj_rad[k], seg)
-        if q is None:
-            res["holds"].offer(line, math.inf, math.inf, f"{label}: no foot in contact: the "
-                               "base cannot be placed", True)
-            continue
-        hold_err, hold_what = 0.0, ""
-        for limb, h in seg.holds.items():
-            p = np.asarray(h.position_m)
-            d_frame = float(np.linalg.norm(v.frame_position(limb) - p))
-            d_target = v.target_distance(h.target, p)
-            if max(d_frame, d_target) >= hold_err:
-                hold_err = max(d_frame, d_target)
-                hold_what = (f"{label}: {limb} {d_frame * 100:.2f} cm from its hold on "
-                             f"{h.target}, hold {d_target * 100:.2f} cm from {h.target}")
-        res["holds"].offer(line, hold_err, hold_err, hold_what, hold_err > HOLD_TOL_M)
-        at_end = line in (seg.first_line, seg.last_line)
-        if every > 1 and (line - seg.first_line) % every and not at_end:
-            continue
-        key = (si, traj_rad[k].tobytes())
-        if key == prev_key and prev_out is not None:  # a dwell line: same as before
-            out = prev_out
-        else:
-            frac = (line - seg.first_line) / max(1, seg.last_line - seg.first_line)
-            v.collision.allow(allowed_contacts(segs, si, frac))
-            hit = v.collision.in_collision(q)
-            clear, pair = math.nan, ""
-            if hit or (line - 1) % CLEARANCE_EVERY_LINES == 0:
-                rep = v.collision.report(q)
-                clear, pair = rep.min_distance_m, " – ".join(rep.closest_pair)
-            held = v.stance(si, seg)
-            rep_s = check_stability(v.model, v.data, q, held.stance, held.region,
-                                    held.torque_limits)
-            tq = rep_s.torque
-            contact = None
-            if tq is not None and tq.feasible:  # the torque LP's own wrenches
-                contact = contact_wrench_utilisation(tq)
-            elif tq is not None:  # the least contact use any share within the joints needs
-                contact = contact_wrench_utilisation(torque_feasibility(
-                    v.model, v.data, q, held.stance, held.torque_limits, v.frame_id,
-                    objective="contact"))
-            out = (hit, clear, pair, rep_s.margin_m,
-                   math.inf if tq is None else tq.max_ratio, "" if tq is None else tq.worst_joint,
-                   tq is not None and tq.feasible, contact)
-            prev_key, prev_out = key, out
-        hit, clear, pair, margin, ratio_t, joint, feasible, contact = out
-        if hit or not math.isnan(clear):
-            d = clear if not math.isnan(clear) else 0.0
-            res["collision"].offer(line, -d + (1.0 if hit else 0.0), d,
-                                   f"{label}: {pair or 'in collision'}", hit)
-        balance = v.stance(si, seg).balance_limbs
-        res["stability margin"].offer(line, -margin, margin,
-                                      f"{label}: CoM margin {margin * 100:.1f} cm in the "
-                                      f"support region of {', '.join(balance)}",
-                                      margin < 0.0)
-        if margin >= 0.0:
-            res["torque ratio"].offer(line, ratio_t, ratio_t, f"{label}: worst joint {joint}",
-                                      not feasible)
-        if contact is not None:
-            res["contact wrench"].offer(line, contact.value, contact.value,
-                                        f"{label}: {contact.detail}", contact.value > 1.0 + 1e-6)
-    return [res[c] for c in CHECKS]
+
+def _check_holds(result: CheckResult, v: _Verifier, line: int, seg: Segment,
+                 label: str) -> None:
+    """Every limb the segment holds: its frame at its hold, and the hold on its object."""
+    hold_err, hold_what = 0.0, ""
+    for limb, h in seg.holds.items():
+        p = np.asarray(h.position_m)
+        d_frame = float(np.linalg.norm(v.frame_position(limb) - p))
+        d_target = v.target_distance(h.target, p)
+        if max(d_frame, d_target) >= hold_err:
+            hold_err = max(d_frame, d_target)
+            hold_what = (f"{label}: {limb} {d_frame * 100:.2f} cm from its hold on "
+                         f"{h.target}, hold {d_target * 100:.2f} cm from {h.target}")
+    result.offer(line, hold_err, hold_err, hold_what, hold_err > HOLD_TOL_M)
+
+
+class _Statics(NamedTuple):
+    """Collision, balance and load figures of one configuration."""
+
+    hit: bool
+    clearance_m: float  # nan when not measured on this line
+    pair: str
+    margin_m: float
+    torque_ratio: float
+    worst_joint: str
+    feasible: bool
+    contact: ContactLoad | None
+
+
+def _statics_at(v: _Verifier, q: np.ndarray, segs: Sequence[Segment], si: int,
+                line: int) -> _Statics:
+    """Collisions (clearance every `CLEARANCE_EVERY_LINES`), the CoM's margin, the torque
+    LP and the contacts' use at ``q``, a line of segment ``si``."""
+    from planner.statics.stability import check_stability, torque_feasibility
+
+    seg = segs[si]
+    frac = (line - seg.first_line) / max(1, seg.last_line - seg.first_line)
+    v.collision.allow(allowed_contacts(segs, si, frac))
+    hit = v.collision.in_collision(q)
+    clear, pair = math.nan, ""
+    if hit or (line - 1) % CLEARANCE_EVERY_LINES == 0:
+        rep = v.collision.report(q)
+        clear, pair = rep.min_distance_m, " – ".join(rep.closest_pair)
+    held = v.stance(si, seg)
+    rep_s = check_stability(v.model, v.data, q, held.stance, held.region, held.torque_limits)
+    tq = rep_s.torque
+    contact = None
+    if tq is not None and tq.feasible:  # the torque LP's own wrenches
+        contact = contact_wrench_utilisation(tq)
+    elif tq is not None:  # the least contact use any share within the joints needs
+        contact = contact_wrench_utilisation(torque_feasibility(
+            v.model, v.data, q, held.stance, held.torque_limits, v.frame_id,
+            objective="contact"))
+    return _Statics(hit, clear, pair, rep_s.margin_m,
+                    math.inf if tq is None else tq.max_ratio,
+                    "" if tq is None else tq.worst_joint, tq is not None and tq.feasible,
+                    contact)
+
+
+def _offer_statics(res: dict[str, CheckResult], line: int, label: str, out: _Statics,
+                   balance: Sequence[str]) -> None:
+    if out.hit or not math.isnan(out.clearance_m):
+        d = out.clearance_m if not math.isnan(out.clearance_m) else 0.0
+        res["collision"].offer(line, -d + (1.0 if out.hit else 0.0), d,
+                               f"{label}: {out.pair or 'in collision'}", out.hit)
+    margin = out.margin_m
+    res["stability margin"].offer(line, -margin, margin,
+                                  f"{label}: CoM margin {margin * 100:.1f} cm in the "
+                                  f"support region of {', '.join(balance)}", margin < 0.0)
+    if margin >= 0.0:
+        res["torque ratio"].offer(line, out.torque_ratio, out.torque_ratio,
+                                  f"{label}: worst joint {out.worst_joint}", not out.feasible)
+    if out.contact is not None:
+        res["contact wrench"].offer(line, out.contact.value, out.contact.value,
+                                    f"{label}: {out.contact.detail}",
+                                    out.contact.value > 1.0 + 1e-6)
+
