@@ -47,6 +47,9 @@ figures and the comparison are in docs/decisions/channels.md.
 The seqlock assumes x86-64's store ordering (TSO); on weakly ordered CPUs (aarch64) the
 counter re-check needs real barriers. Do not fork a process that holds a channel open:
 the child shares its open file description, and so its locks.
+
+Size: the file layout, the seqlock and the futex wake-up are one protocol between
+processes; each part is only correct together with the others.
 """
 
 from __future__ import annotations

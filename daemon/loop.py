@@ -44,6 +44,9 @@ drives zero PWM duty: limp). The state reports such joints with ``NOT_HOMED``.
 
 Board commands are latest-value samples: two written within one tick, only the newer is
 seen. Writers (``hubo-console``) wait for the next ticks before sending another.
+
+Size: the tick's steps (backend, reference gates, control law, commands, state,
+log, watchdog) share the loop's state each 5 ms, and are kept in the order they run.
 """
 
 from __future__ import annotations

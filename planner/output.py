@@ -10,6 +10,10 @@ PWM (compliant) mode is scheduled for an arm while its hand holds a rail or its 
 within `PWM_RAIL_DISTANCE_M` of its rail's axis (closing, opening, the first and last
 centimetres of a reach); position mode while the hand moves through the air, and
 throughout a plan made for rigid arms (``arm_strategy`` ``position``).
+
+Size: one pass over the timed lines builds both files: the trajectory, and the
+sidecar's segments, arm-mode schedule, feed-forward torques and metrics, which all
+read the same timed configurations.
 """
 
 from __future__ import annotations

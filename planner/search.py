@@ -3,6 +3,11 @@
 Each step samples a hold near the primitive's seed hold (radius 0 at first, growing with
 failures), a configuration feasible at both the old and the new stance, and a path. A
 step that fails ``samples_per_step`` times backtracks: the previous step is re-sampled.
+
+Size: one class, `ClimbPlanner`, whose methods share the search's state (the
+kinematic model, the feasibility checker, the random generator, hints from earlier
+samples); `try_step` reads as the step's phases (lift off, open hands, carry, place,
+close hands).
 """
 
 from __future__ import annotations

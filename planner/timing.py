@@ -21,6 +21,10 @@ After each step (a stance change) the last line is repeated for a quasi-static d
 Every output line keeps the index of the segment it came from, whether it is a dwell
 line, and a full configuration (floating base included, interpolated along ``s`` like
 the joints), which the sidecar's mode schedule needs for palm-to-rail distances.
+
+Size: one pipeline (spline fit, toppra, its fall-backs when the LP fails, sampling
+at the file rate, the limit check of the sampled lines) whose stages pass each other
+toppra's intermediate objects.
 """
 
 from __future__ import annotations

@@ -37,6 +37,9 @@ Our interpretation where the facts are silent (ASSUMPTIONS, to check against a b
   sends a gyro reply at 0x58 + board: int16 LE wx, wy, wz [0.001 rad/s].
 - **Power reply** at 0x40 + 0x0E (the power board's number): uint16 LE V [0.01 V],
   int16 LE I [0.01 A]; P = V·I.
+
+Size: the protocol's table: every frame kind's encoder beside its decoder, and the
+vectorised cycle plan built from them.
 """
 
 from __future__ import annotations

@@ -39,6 +39,9 @@ A holding arm. An arm in PWM mode keeps hubo-ach's law while its hand holds the 
 its stiffness towards the reference (kp) plus the feed-forward. The closed chain through
 the rail leaves the arm's pose free (a hand turns on its rail, `daemon.sim.grasp_latch`),
 and the stiffness is what holds it there (docs/decisions/arm-feedforward.md).
+
+Size: one state machine (hubo-read-trajectory's: go-to-init, play, pause, finish)
+and the per-arm mode schedule and feed-forward it applies each tick.
 """
 
 from __future__ import annotations

@@ -26,6 +26,10 @@ outside the region can skip the torque LP (`check_stability` does).
 
 Frames: world x forward, y left, z up; gravity along −z. Forces are those the environment
 applies to the robot [N].
+
+Size: the support region and the torque LP share the contact model's linearised
+cones and wrench bases; they are the candidates for two modules (support_region,
+torque_lp) once the contact model (issue 22) settles.
 """
 
 from __future__ import annotations

@@ -30,6 +30,10 @@ The contacts are the contact model's, whole: the grip's full capacity (the plann
 its tread (the planner keeps a friction share and a centre-of-pressure margin).
 
 `check_plan` returns, per check, the worst line and whether any line fails.
+
+Size: every check runs in one pass over the lines, on the configuration
+`_Verifier` rebuilds from the sidecar's holds; `check_plan` reads as that pass
+(limits and speed, holds, then the statics of each checked line).
 """
 
 from __future__ import annotations
