@@ -28,8 +28,11 @@ latch lets go (`RELEASE_LOADS`). Along and about the rail the grip slips (`SLIP_
 The wrench is the one the rail applies to the hand, about the palm site (the grip
 centre, on the rail axis), world frame.
 
-The planner's LP takes these limits as linear inequalities (`HandLimits.halfspaces`) on
-the hand's 6-D wrench, scaled by `GRIP_RESERVE`; check-plan takes them whole. The
+The torque LP can take these limits as linear inequalities (`HandLimits.halfspaces`) on
+the hand's 6-D wrench, a share of them or whole; check-plan takes them whole. The planner
+keeps the thesis's point hold for hands (`planner.holds`): planned with the grip's limits
+at a 0.8 reserve, DRC mounts climbed far less often in MuJoCo
+(docs/decisions/contact-model.md). The
 linearisation is conservative: the radial and bending discs are inscribed polygons, and
 the friction along and about the rail counts only the radial load's component along the
 *up-radial* direction (``|F_r| ≥ u·F_r``), the direction a hand carrying weight presses
@@ -46,26 +49,18 @@ line across the sole at the rung's top, so the patch has no extent along the sol
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
 from robot.kinematic_tree import FINGER_JOINT_ABOVE_GRIP_M, FINGER_JOINT_OUTSET_M
 
-__all__ = ["FINGER_X_M", "GRIP_LOADS", "GRIP_RESERVE", "HUBO_GRIP", "RELEASE_LOADS",
+__all__ = ["FINGER_X_M", "GRIP_LOADS", "HUBO_GRIP", "RELEASE_LOADS",
            "SLIP_LOADS", "FootPatch", "GripCapacity", "GripGeometry", "HandLimits",
            "default_grip", "hand_limits", "sole_patch_x"]
 
 #: Finger positions along the grip axis [m] (robot.kinematic_tree: −0.036 + 0.018·i).
 FINGER_X_M = (-0.036, -0.018, 0.0, 0.018, 0.036)
-
-#: Share of the grip's capacity the planner plans a hand's wrench to. The load a
-#: compliant arm really puts on its grip is not the LP's (the arm gives what its PWM law
-#: gives, the legs take the rest), and the latch lets go at 1.0: DRC batches ended in
-#: "bending torque 1.00× what the grip holds" on plans whose hands carried no planned
-#: moment at all (issue 22). 0.8 is the usual engineering reserve on a holding device,
-#: not a tuned figure; check-plan checks the whole capacity.
-GRIP_RESERVE = 0.8
 
 #: Loads a closed hand gives way to by slipping on its rail (still latched), in the order
 #: the latch reads them: along, about.
@@ -187,7 +182,7 @@ def _norm(v: np.ndarray) -> float:
 @dataclass(frozen=True, eq=False)
 class HandLimits:
     """The limits of one hand hold: the grip's capacity on a rail along ``axis``, of
-    which ``share`` may be used (`GRIP_RESERVE` in the planner, 1 in check-plan).
+    which ``share`` may be used (1 in check-plan).
 
     Attributes:
         capacity: the grip's capacity on this rail.
@@ -246,9 +241,6 @@ class HandLimits:
         """Each of `GRIP_LOADS` as a share of the whole capacity (what the latch reads)."""
         return self.capacity.utilisation(np.asarray(force_n, float),
                                          np.asarray(torque_nm, float), self.rail_frame()[:, 0])
-
-    def scaled(self, share: float) -> HandLimits:
-        return replace(self, share=share)
 
     def __repr__(self) -> str:
         c = self.capacity

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ladders.contact_model import GRIP_RESERVE, FootPatch, hand_limits, sole_patch_x
+from ladders.contact_model import FootPatch, sole_patch_x
 from ladders.geometry import LadderGeometry
 from planner.contacts import Hold
 from primitives.hold_seeds import FloorSeed, HoldSeed, RailSeed, RungSeed
@@ -131,13 +131,12 @@ def make_hold(seed: HoldSeed, geom: LadderGeometry, params: RobotParams,
               floor_pose: dict[str, np.ndarray] | None = None, offset_m=(0.0, 0.0),
               shoulder_m: np.ndarray | None = None, grip_style: str = "facing",
               cop_margin_m: float = FOOT_COP_MARGIN_M,
-              friction_share: float = FOOT_FRICTION_SHARE,
-              grip_share: float = GRIP_RESERVE) -> Hold:
+              friction_share: float = FOOT_FRICTION_SHARE) -> Hold:
     """A concrete hold for a seed, shifted by ``offset_m`` = (along, lateral) in L [m].
 
     A rail hold takes a ``grip_style`` (see `palm_rotation`); the ``shoulder`` style needs
-    ``shoulder_m``, the current position of that arm's shoulder [m]. Its limits are the
-    grip's (`ladders.contact_model.hand_limits`), of which it may use ``grip_share``.
+    ``shoulder_m``, the current position of that arm's shoulder [m]; it is the thesis's
+    point hold (see below).
     A foot hold's contact patch (`ladders.contact_model`: the sole ∩ tread overlap, a
     line on a round rung) keeps its centre of pressure ``cop_margin_m`` inside its
     sides, and its friction is ``friction_share`` of the ladder's μ.
@@ -170,11 +169,12 @@ def make_hold(seed: HoldSeed, geom: LadderGeometry, params: RobotParams,
                                                      seed.torso_along_m))
         p = rail_point(geom, seed.side, seed.rung, along + offset_m[0])
         T = _pose(palm_rotation(geom, seed.side, p, shoulder_m, grip_style), p)
-        # The thesis's point hold (a contact pushing up and one pulling the hand towards
-        # the ladder) stays as the hold's points; the torque LP and the CoM region take
-        # the grip's wrench limits instead.
+        # The thesis's point hold: a contact pushing up and one pulling the hand towards
+        # the ladder, at the grip centre, in μ cones. The grip's 6-D wrench limits
+        # (`ladders.contact_model.hand_limits`) are what check-plan verifies and the latch
+        # enforces; planned with them (0.8 reserve, moments or forces only), DRC mounts
+        # climbed far less often in MuJoCo (docs/decisions/contact-model.md).
         towards_ladder = geom.R_world_ladder @ np.array([1.0, 0.0, 0.0])
-        limits = hand_limits(mu, geom.spec.rail_radius_m, geom.ladder_direction, grip_share)
         return Hold(seed.limb, seed.target, T, np.vstack([p, p]),
-                    np.vstack([up, towards_ladder]), mu, limits=limits)
+                    np.vstack([up, towards_ladder]), mu)
     raise TypeError(f"unknown seed {seed!r}")
