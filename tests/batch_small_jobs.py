@@ -37,6 +37,7 @@ def small_plan(job: PlanJob, out_dir: str) -> dict:
     margin = float(0.05 + 0.02 * rng.standard_normal() - 0.001 * (job.ladder.slope_deg - 60))
     if margin < 0.0:
         return {"outcome": "no_plan", "cause": "no_plan", "plan_s": 0.0,
+                "where": "climbRung at rung 1",
                 "why": f"climbRung at rung 1: margin {margin:.3f} m < 0"}
     name = f"plans/{job.ladder_key}-s{job.seed}.json"
     path = Path(out_dir) / name

@@ -209,12 +209,13 @@ def plan_job(job: PlanJob, out_dir: str) -> dict:
         with hard_time_limit(job.time_limit_s + HARD_LIMIT_GRACE_S):
             result = planner.plan(top_rung=top)
     except PlanningFailed as exc:
+        where = f"{exc.step.primitive.name} at rung {exc.step.rung}"
         return {"outcome": "no_plan", "cause": "no_plan", "plan_s": time.perf_counter() - t0,
-                "top_rung": top, "why": f"{exc.step.primitive.name} at rung {exc.step.rung}: "
-                                        f"{exc.reason}"}
+                "top_rung": top, "where": where, "why": f"{where}: {exc.reason}"}
     except TimeLimitExceeded:
         return {"outcome": "no_plan", "cause": "no_plan", "plan_s": time.perf_counter() - t0,
-                "top_rung": top, "why": f"time limit of {job.time_limit_s:g} s reached"}
+                "top_rung": top, "where": "time limit",
+                "why": f"time limit of {job.time_limit_s:g} s reached"}
     search_s = time.perf_counter() - t0
     out = Path(out_dir) / job.traj_name
     out.parent.mkdir(parents=True, exist_ok=True)
@@ -223,7 +224,7 @@ def plan_job(job: PlanJob, out_dir: str) -> dict:
                              {"search_s": result.total_s, "setup_s": search_s - result.total_s})
     except TimingError as exc:
         return {"outcome": "no_plan", "cause": "no_plan", "plan_s": time.perf_counter() - t0,
-                "top_rung": top, "why": f"timing: {exc}"}
+                "top_rung": top, "where": "timing", "why": f"timing: {exc}"}
     return {"outcome": "planned", "traj": job.traj_name, "plan_s": time.perf_counter() - t0,
             "search_s": result.total_s, "motion_s": written.timed.duration_s,
             "lines": written.sidecar.line_count, "top_rung": top}

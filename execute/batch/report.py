@@ -85,9 +85,10 @@ class Summary:
         return total
 
 
-def _no_plan_reason(why: str) -> str:
-    """``climbRung at rung 2: 50 samples failed; ...`` → ``climbRung at rung 2``."""
-    return why.split(":")[0] if why else "?"
+def _no_plan_reason(record: dict) -> str:
+    """Where a plan job found no plan (its ``where`` field: ``climbRung at rung 2``,
+    ``time limit``, ``timing``); ``?`` for a record written before the field existed."""
+    return record.get("where") or "?"
 
 
 def summarize_records(records: Iterable[dict], ladders: Mapping[str, LadderSpec],
@@ -131,7 +132,7 @@ def summarize_records(records: Iterable[dict], ladders: Mapping[str, LadderSpec]
         recs = plans.get(key, [])
         ok = [r for r in recs if r.get("status") == "ok"]
         found = [r for r in ok if r.get("outcome") == "planned"]
-        why = Counter(_no_plan_reason(r.get("why", "")) for r in ok
+        why = Counter(_no_plan_reason(r) for r in ok
                       if r.get("outcome") != "planned")
         prow.append(PlanRow(key, SuccessRate(len(found), len(ok)), len(recs) - len(ok),
                             summarize(r.get("plan_s") for r in found),
