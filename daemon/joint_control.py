@@ -12,11 +12,11 @@ control law, per joint:
 One tick, per joint, as hubo-ach did it:
 
 1. A commanded reference outside the joint limits of the robot description (by more than
-   `robot.limits.LIMIT_TOLERANCE_RAD`) is rejected: that joint keeps its previous
+   `robot.limits.REF_CLAMP_TOLERANCE_RAD`, 1 mrad) is rejected: that joint keeps its previous
    accepted reference, and :attr:`ControlOutput.limit_rejected` names it. hubo-ach
    clamped it instead, which moved the joint to its limit: a ``goto RKN 3.0`` drove the
-   knee to 2.61 rad, and the simulated robot fell. Values within the tolerance (float
-   slack) are clamped.
+   knee to 2.61 rad, and the simulated robot fell. Values within the tolerance (the
+   float noise of computed references) are clamped.
 2. The sent reference ``f`` is filtered by the joint's reference mode
    (``daemon.control_modes``).
 3. Compliance:
@@ -64,7 +64,7 @@ from daemon.control_modes import (
 from daemon.pwm import PwmGains, pwm_duty
 from robot.errors import InputError
 from robot.joints import ARM_JOINTS, FINGER_JOINTS, JOINT_INDEX, JOINT_NAMES, NUM_JOINTS
-from robot.limits import LIMIT_TOLERANCE_RAD, JointLimits, joint_limits
+from robot.limits import REF_CLAMP_TOLERANCE_RAD, JointLimits, joint_limits
 from robot.pwm_gains import PWM_COMMAND_LIMIT_PCT
 
 __all__ = [
@@ -266,7 +266,8 @@ class JointController:
         if self._sent_rad is None:
             self.reset(pos)
         lower, upper = self.limits.lower_rad, self.limits.upper_rad
-        rejected = (ref_in < lower - LIMIT_TOLERANCE_RAD) | (ref_in > upper + LIMIT_TOLERANCE_RAD)
+        rejected = ((ref_in < lower - REF_CLAMP_TOLERANCE_RAD)
+                    | (ref_in > upper + REF_CLAMP_TOLERANCE_RAD))
         ref, ref_clamped = clamp_reference(np.where(rejected, self._ref_rad, ref_in), lower,
                                            upper)
         ref_clamped &= ~rejected

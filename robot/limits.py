@@ -15,6 +15,12 @@ from robot.params import RobotParams, robot_params
 #: values written by a formatter. The trajectory reader accepts such values and the
 #: daemon clamps them; anything farther is refused (reader) or rejected (daemon).
 LIMIT_TOLERANCE_RAD = 1e-9
+#: How far past a joint limit the daemon still clamps a commanded reference onto it [rad];
+#: farther, it rejects the reference (the joint holds its previous one). Writers that
+#: compute references (the motion layer's corrections) land up to about 2e-6 rad past a
+#: limit the plan sits on (a straight elbow at 0); 1e-3 rad is far below anything that
+#: moves the robot and far above that noise.
+REF_CLAMP_TOLERANCE_RAD = 1e-3
 
 
 @dataclass(frozen=True)

@@ -80,13 +80,19 @@ def test_a_reference_beyond_a_limit_is_rejected_and_the_previous_one_held():
     assert not out.limit_rejected.any()
 
 
-def test_float_slack_at_a_limit_is_clamped_not_rejected():
+def test_float_noise_at_a_limit_is_clamped_not_rejected():
     c = JointController()
     ref = np.zeros(N)
-    ref[J["RKN"]] = -1e-10  # lower limit 0, within LIMIT_TOLERANCE_RAD
+    ref[J["RKN"]] = -1e-10  # lower limit 0
+    ref[J["REB"]] = 1.6e-6  # upper limit 0: a computed straight elbow, as the motion layer's
+    ref[J["LEB"]] = 9e-4  # within REF_CLAMP_TOLERANCE_RAD (1e-3)
     out = c.tick(ref, RefMode.DIRECT, RIGID, ZERO, ZERO, default_drc_gains())
-    assert out.ref_sent_rad[J["RKN"]] == 0.0 and out.limit_clamped[J["RKN"]]
+    for name in ("RKN", "REB", "LEB"):
+        assert out.ref_sent_rad[J[name]] == 0.0 and out.limit_clamped[J[name]]
     assert not out.limit_rejected.any()
+    ref[J["LEB"]] = 2e-3  # beyond it: rejected, LEB keeps 0
+    out = c.tick(ref, RefMode.DIRECT, RIGID, ZERO, ZERO, default_drc_gains())
+    assert out.limit_rejected[J["LEB"]] and out.ref_sent_rad[J["LEB"]] == 0.0
 
 
 def test_encoder_following_modes_are_clamped_too():
