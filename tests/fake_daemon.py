@@ -74,3 +74,6 @@ def running_daemon(name: str, pos_rad: np.ndarray | None = None):
         thread.join(5.0)
         channels.close()
         cleanup_stale(instance)
+        from execute.play.lock import player_lock_path
+
+        player_lock_path(instance).unlink(missing_ok=True)  # left by play-trajectory runs
