@@ -206,7 +206,9 @@ def test_can_daemon_plays_the_fixture_over_virtual_buses(plan, tmp_path):
     try:
         d.start()
         d.home()
-        r = play(d.instance, "-n", str(plan), "-i")
+        # Emulated boards have no ladder: closed loop, the fingers close on nothing and
+        # the motion layer (rightly) stops at the first grasp; the CAN path is the subject.
+        r = play(d.instance, "-n", str(plan), "-i", "--open-loop")
         assert r.returncode == 0, r.stderr
         time.sleep(1.5)
         d.stop()
