@@ -32,7 +32,7 @@ import time
 from pathlib import Path
 
 from robot.constants import DAEMON_RATE_HZ
-from robot.errors import HuboLadderError, InputError
+from robot.errors import HuboLadderError, InputError, run_cli
 from robot.vocabulary import ArmStrategy
 
 __all__ = ["main", "parse_args"]
@@ -274,8 +274,17 @@ def run(opts: dict, console, err, functions=None, engine=None) -> int:
     return 0
 
 
+class BatchSetupError(HuboLadderError):
+    """The batch could not run: an optional dependency is missing (Dask) or a file
+    cannot be read or written."""
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of ``batch-eval``; returns the exit code."""
+    return run_cli("batch-eval", lambda: _main(argv))
+
+
+def _main(argv: list[str] | None) -> int:
     from rich.console import Console
 
     from robot.text_console import text_console
@@ -285,9 +294,6 @@ def main(argv: list[str] | None = None) -> int:
         opts = parse_args(argv)
     except SystemExit as exc:  # argparse: --help (0) or a bad option (2)
         return int(exc.code or 0)
-    except InputError as exc:
-        err.print(f"batch-eval: {exc}", markup=False, highlight=False, soft_wrap=True)
-        return 2
     logging.basicConfig(level=logging.INFO if opts["verbose"] else logging.WARNING,
                         format="%(name)s: %(message)s", force=True)
     console = Console()
@@ -299,13 +305,8 @@ def main(argv: list[str] | None = None) -> int:
         err.print(f"batch-eval: interrupted; finished jobs are in {opts['out']}/results.jsonl, "
                   "run the same command again to resume", highlight=False)
         return 130
-    except InputError as exc:
-        err.print(f"batch-eval: {exc}", markup=False, highlight=False, soft_wrap=True)
-        return 2
-    except (HuboLadderError, ImportError, OSError) as exc:
-        err.print(f"batch-eval: {exc}", markup=False, highlight=False, soft_wrap=True)
-        return 1
-
+    except (ImportError, OSError) as exc:
+        raise BatchSetupError(str(exc)) from exc
 
 if __name__ == "__main__":
     sys.exit(main())
