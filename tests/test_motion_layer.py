@@ -206,7 +206,7 @@ def test_validate_plan_reports_the_loop_and_what_the_layer_did(reach, tmp_path, 
     closed, opened = tmp_path / "closed.json", tmp_path / "open.json"
     assert validate_main([str(path), "--json", str(closed)]) == 0
     out = capsys.readouterr().out
-    assert "motion layer: 2 grasp verified" in out
+    assert "motion layer: " in out and "2 grasp verified" in out
     assert validate_main([str(path), "--open-loop", "--json", str(opened)]) == 0
     c, o = json.loads(closed.read_text()), json.loads(opened.read_text())
     assert (c["loop"], o["loop"]) == ("closed", "open")

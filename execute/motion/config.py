@@ -43,6 +43,8 @@ _RANGES = {
     "shift_s": (0.2, 5.0),
     "close_s": (0.2, 5.0),
     "verify_timeout_s": (0.1, 5.0),
+    "arrival_tolerance_m": (0.002, 0.05),
+    "arrival_timeout_s": (0.0, 10.0),
     "hold_after_stop_s": (0.0, 30.0),
 }
 
@@ -64,6 +66,9 @@ class MotionConfig:
         search_step_m: spacing of the re-reach pattern around the target [m].
         open_s, shift_s, close_s: durations of a re-reach's opening, move and closing [s].
         verify_timeout_s: how long a closed hand may take to read on-rail or empty [s].
+        arrival_tolerance_m: how close the palm must come to where its reference puts it
+            before the hand closes [m].
+        arrival_timeout_s: the longest wait for that [s].
         hold_after_stop_s: how long the pose is held after the layer stops, before the
             run ends (validation only) [s].
         estimator: the state estimator's thresholds.
@@ -79,6 +84,8 @@ class MotionConfig:
     shift_s: float = 1.5
     close_s: float = 1.0
     verify_timeout_s: float = 1.5
+    arrival_tolerance_m: float = 0.01
+    arrival_timeout_s: float = 4.0
     hold_after_stop_s: float = 2.0
     estimator: EstimatorConfig = field(default_factory=EstimatorConfig)
 

@@ -4,6 +4,9 @@ It sits between the trajectory player and the daemon's control law, and rebuilds
 hubo-motion-rt and the thesis's operator did (thesis §4.3.4, §6.2):
 
 - **gravity compensation** of the compliant arms (`execute.motion.gravity_compensation`);
+- **arrival**: before a hand closes, the player waits until the encoders put its palm
+  within ``arrival_tolerance_m`` of where its reference does (a PWM arm lags its
+  reference), at most ``arrival_timeout_s``;
 - **grasp verification**: at the end of every grasp the plan makes, the player waits
   until the finger encoders read the hand closed on its rail
   (`execute.motion.grasp_check`). Only then does the plan go on to put load on it;
@@ -98,7 +101,7 @@ class _Regrasp:
     segment: int
     rail: str
     planned_m: np.ndarray
-    phase: str  # "retarget", "verify", "open", "shift", "close"
+    phase: str  # "retarget", "arrive", "verify", "open", "shift", "close"
     since_s: float
     tries: int = 0
     candidates: list = dataclasses.field(default_factory=list)  # re-reach shifts [m]
@@ -145,6 +148,8 @@ class MotionLayer:
         self._shift_m: dict[str, np.ndarray] = {}  # limb → world shift its offset makes [m]
         self._segment = -1
         self._verified_segments: set[tuple[int, str]] = set()
+        self._arrived: set[tuple[int, str]] = set()
+        self._last_ref = np.asarray(trajectory_rad[0], dtype=float).copy()
         self._regrasp: _Regrasp | None = None
         self._open_fingers: set[str] = set()
         self.events: list[MotionEvent] = []
@@ -257,14 +262,24 @@ class MotionLayer:
         side, rail, planned = pending
         if line_index >= seg.last_line - 1:
             return _Regrasp(side, k, rail, planned, "verify", self._now)
-        if line_index == seg.first_line - 1 and self.ladder.observed:
+        if line_index == seg.first_line - 1:
             limb = f"{side}_hand"
             wanted = self._ladder_shift(planned)
             if np.linalg.norm(wanted - self._shift_m.get(limb, np.zeros(3))) > SAME_TARGET_M:
                 g = _Regrasp(side, k, rail, planned, "retarget", self._now)
                 self._move_hand(g, wanted, "the ladder estimate moved its target")
                 return g
+            if (k, side) not in self._arrived:
+                return _Regrasp(side, k, rail, planned, "arrive", self._now)
         return None
+
+    def _palm_lag_m(self, side: str, s: SensedState) -> float:
+        """How far the sensed palm stands from where its reference puts it, in the pelvis
+        frame (no pose estimate involved) [m]."""
+        frame = f"{side[0].upper()}_palm"
+        want = self.model.frame_in_pelvis(self._last_ref, frame)[:3, 3]
+        got = self.model.frame_in_pelvis(s.pos_rad, frame)[:3, 3]
+        return float(np.linalg.norm(got - want))
 
     def _candidates(self, g: _Regrasp) -> list[np.ndarray]:
         """Re-reach shifts [m]: the ladder estimate's target, then a pattern around it,
@@ -302,6 +317,16 @@ class MotionLayer:
         if g.phase == "retarget":
             if elapsed >= cfg.shift_s:
                 self._settle_offset(limb)
+                self._regrasp = None
+                self.player.resume(now)
+        elif g.phase == "arrive":
+            lag = self._palm_lag_m(g.side, s)
+            if lag <= cfg.arrival_tolerance_m or elapsed >= cfg.arrival_timeout_s:
+                self._arrived.add((g.segment, g.side))
+                if elapsed > 0.0:
+                    self._event(MotionEventKind.ARRIVAL_WAIT, limb, lag,
+                                f"waited {elapsed:.2f} s for the palm to reach its reference "
+                                f"before closing ({lag * 100:.1f} cm off at the end)")
                 self._regrasp = None
                 self.player.resume(now)
         elif g.phase in ("verify", "close"):
@@ -405,6 +430,7 @@ class MotionLayer:
             ref += blend.at(t)
         for side in self._open_fingers:
             ref[self._finger_cols[side]] = 0.0
+        self._last_ref = ref
         mode = tick.mode
         seg = self.sidecar.segments[int(self._segment_of_line[tick.line_index])]
         dt = 0.0 if self._last_now is None else self._now - self._last_now
