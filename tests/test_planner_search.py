@@ -262,7 +262,7 @@ def test_narrow_rails_mount_leaves_the_arms_a_lift_off_within_their_torque():
     target = p._target(steps[2], stance.holds, (), Stance(support),
                        p._contacts(stance.holds), pelvis, q=q)
     q_lift, verdict = find_feasible(p.kin, p.checker, q, target, np.random.default_rng(1),
-                                    attempts=3)
+                                    attempts=12)
     assert q_lift is not None and verdict.torque_ratio <= 1.0
     fold_limit_rad = p.kin.model.lowerPositionLimit[p.kin.q_index["LEB"]]
     for elbow in ("LEB", "REB"):
