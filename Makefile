@@ -21,9 +21,9 @@ $(STAMP): pyproject.toml
 demo: install
 	mkdir -p demo-out
 	$(BIN)/python -m ladders show drc --out demo-out
-	$(BIN)/plan-ladder drc --seed 6 -o demo-out/drc.traj --plots demo-out/stances
-	$(BIN)/check-plan demo-out/drc.traj --ladder drc --every 10
-	MUJOCO_GL=egl $(BIN)/validate-plan demo-out/drc.traj --strategy mixed \
+	$(BIN)/plan-ladder drc --seed 6 -o demo-out/drc.traj.gz --plots demo-out/stances
+	$(BIN)/check-plan demo-out/drc.traj.gz --ladder drc --every 10
+	MUJOCO_GL=egl $(BIN)/validate-plan demo-out/drc.traj.gz --strategy mixed \
 		--json demo-out/drc.result.json --plots demo-out/plots; \
 		status=$$?; [ $$status -le 1 ] || exit $$status; \
 		echo "validate-plan verdict written to demo-out/drc.result.json (exit $$status)"

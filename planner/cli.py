@@ -43,8 +43,8 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--rate", type=float, default=DAEMON_RATE_HZ, metavar="HZ",
                    help=f"trajectory file rate [Hz] (default {DAEMON_RATE_HZ:g})")
     p.add_argument("-o", "--out", metavar="OUT.traj",
-                   help="trajectory file (default: LADDER-NAME.traj); the sidecar "
-                        "OUT.plan.json goes next to it")
+                   help="trajectory file (default: LADDER-NAME.traj; OUT.traj.gz writes it "
+                        "gzip-compressed); the sidecar OUT.plan.json goes next to it")
     p.add_argument("--time-limit", type=float, default=600.0, metavar="S",
                    help="give up planning after this long [s] (default 600)")
     p.add_argument("--resolution", type=float, default=0.01, metavar="RAD",

@@ -159,10 +159,12 @@ class PlanSidecar:
 
 
 def sidecar_path(traj_path: str | os.PathLike) -> Path:
-    """``climb.traj`` → ``climb.plan.json``."""
+    """``climb.traj`` and ``climb.traj.gz`` → ``climb.plan.json``."""
     p = Path(traj_path)
-    return p.with_name(p.stem + ".plan.json") if p.suffix == ".traj" else \
-        p.with_name(p.name + ".plan.json")
+    for suffix in (".traj", ".traj.gz"):
+        if p.name.endswith(suffix) and len(p.name) > len(suffix):
+            return p.with_name(p.name.removesuffix(suffix) + ".plan.json")
+    return p.with_name(p.name + ".plan.json")
 
 
 def write_sidecar(path: str | os.PathLike, sidecar: PlanSidecar) -> None:

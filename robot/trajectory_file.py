@@ -4,10 +4,18 @@ One line per setpoint, whitespace-separated radians in ``JOINT_NAMES`` order, no
 line k is played at time k / rate. The original player read lines with a 1000-byte
 ``fgets`` and an unchecked ``sscanf``; we check the whole file before anything moves and
 report every problem as ``file:line:column: message``.
+
+A name ending in ``.gz`` (``climb.traj.gz``) is the same text gzip-compressed: every
+reader and writer here handles it, so every command that takes a ``.traj`` takes a
+``.traj.gz``. Values are written rounded to `DECIMALS` places (a nanoradian, four orders
+below the encoders' resolution): the full 17 digits of a float are noise that neither
+the robot nor gzip can use. A DRC climb of 314,000 lines at 200 Hz is 226 MB with 17
+digits (gzip makes it 71 MB), 123 MB rounded, and 39 MB rounded and gzipped.
 """
 
 from __future__ import annotations
 
+import gzip
 import math
 import os
 from dataclasses import dataclass
@@ -26,6 +34,7 @@ __all__ = [
     "ClampedJoint",
     "format_clamps",
     "format_trajectory",
+    "is_gzip_path",
     "parse_trajectory",
     "read_trajectory",
     "read_trajectory_clamped",
@@ -38,6 +47,17 @@ MAX_LINE_CHARS = 998
 #: The largest ``--clamp-limits`` tolerance [rad]: files of the original player overshoot
 #: the knee's lower limit by up to 0.07 rad; a larger tolerance would hide real errors.
 MAX_CLAMP_TOLERANCE_RAD = 0.1
+#: Decimal places written [rad]: the rounding error (at most 5e-10 rad) stays within
+#: ``LIMIT_TOLERANCE_RAD`` of a value on a limit; the Hubo encoders resolve about 1e-5 rad.
+DECIMALS = 9
+#: gzip's level for ``.traj.gz``: 6 (gzip's default) 5.84x on a DRC climb in 1.5 s per
+#: 30,000 lines, level 9 hardly smaller at twice the time.
+GZIP_LEVEL = 6
+
+
+def is_gzip_path(path: str | os.PathLike) -> bool:
+    """True for a name ending in ``.gz`` (written compressed)."""
+    return str(path).lower().endswith(".gz")
 
 
 @dataclass(frozen=True)
@@ -90,15 +110,19 @@ def format_clamps(source: str, clamps: tuple[ClampedJoint, ...], tol_rad: float)
 
 
 def format_trajectory(q_rad: np.ndarray) -> str:
-    """Text of a trajectory: one line per row, shortest exact float repr, '\\n' endings."""
+    """Text of a trajectory: one line per row, '\\n' endings, each value rounded to
+    `DECIMALS` places and written in the shortest form that reads back as that value
+    (so writing what was read gives the same text)."""
     q_rad = np.asarray(q_rad, dtype=float)
     if q_rad.ndim != 2 or q_rad.shape[1] != NUM_JOINTS:
         raise ValueError(f"expected an (N, {NUM_JOINTS}) array, got shape {q_rad.shape}")
     if not np.all(np.isfinite(q_rad)):
         raise ValueError("trajectory contains NaN or inf")
+    # k / 10**9 is correctly rounded, so repr gives at most 9 decimals; + 0.0 drops "-0.0"
+    q_rad = np.round(q_rad, DECIMALS) + 0.0
     lines = []
-    for row in q_rad:
-        line = " ".join(repr(float(v)) for v in row)
+    for row in q_rad.tolist():
+        line = " ".join(map(repr, row))
         assert len(line) <= MAX_LINE_CHARS, "a formatted line cannot exceed the reader's buffer"
         lines.append(line)
     return "\n".join(lines) + "\n"
@@ -106,12 +130,17 @@ def format_trajectory(q_rad: np.ndarray) -> str:
 
 def write_trajectory(path: str | os.PathLike, q_rad: np.ndarray) -> None:
     """Write ``q_rad`` (N, 40) so that hubo-read-trajectory and ``read_trajectory`` read it
-    back bit for bit. Written to a temporary file and renamed, so a crash leaves no half file.
+    back to within half a nanoradian (`DECIMALS`), and what was read writes back bit for
+    bit. Written to a temporary file and renamed, so a crash leaves no half file.
+    A name ending in ``.gz`` is written gzip-compressed (no name or time in the header, so
+    the same trajectory gives the same bytes); ``gunzip`` gives the plain file.
     """
     path = Path(path)
-    text = format_trajectory(q_rad)
+    data = format_trajectory(q_rad).encode("ascii")
+    if is_gzip_path(path):
+        data = gzip.compress(data, compresslevel=GZIP_LEVEL, mtime=0)
     tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(text)
+    tmp.write_bytes(data)
     tmp.replace(path)
 
 
@@ -282,6 +311,12 @@ def _read_text(path: str | os.PathLike) -> str:
         raw = path.read_bytes()
     except OSError as exc:
         raise TrajectoryFileError(str(path), [f"{path}: cannot read: {exc.strerror}"]) from None
+    if raw[:2] == b"\x1f\x8b":  # gzip's magic, whatever the name says
+        try:
+            raw = gzip.decompress(raw)
+        except (OSError, EOFError) as exc:
+            raise TrajectoryFileError(str(path), [f"{path}: not a readable gzip file: {exc}"]
+                                      ) from None
     try:
         text = raw.decode("ascii")
     except UnicodeDecodeError as exc:

@@ -51,3 +51,17 @@ def synthetic_plan() -> tuple[ClimbPlanner, SearchResult, np.ndarray]:
                 PathSegment(s2, "body", stance.holds, (), up)]
     stats = [StepStats(s1.label, 0.1, 3, 0, 0.05, 0.4), StepStats(s2.label, 0.2, 5, 1, 0.04, 0.5)]
     return planner, SearchResult(segments, stance, stats, 0.3), q0
+
+
+def use_synthetic_search(monkeypatch) -> SearchResult:
+    """Replace `ClimbPlanner.plan` by the synthetic plan (the real search is slow), with its
+    progress calls; returns the result it gives."""
+    _, result, _ = synthetic_plan()
+
+    def plan(self, top_rung=None, progress=None):
+        for i, st in enumerate(result.step_stats):
+            progress(i, 4, result.segments[0].step, st)
+        return result
+
+    monkeypatch.setattr(ClimbPlanner, "plan", plan)
+    return result

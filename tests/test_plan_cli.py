@@ -11,7 +11,7 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).parent))
 
-from synthetic_plan import synthetic_plan  # noqa: E402
+from synthetic_plan import use_synthetic_search  # noqa: E402
 
 from ladders.loader import ladder_to_yaml, load_ladder  # noqa: E402
 from planner.cli import main  # noqa: E402
@@ -77,15 +77,7 @@ def test_unreachable_ladder_gives_exit_1(tmp_path, capsys):
 @pytest.fixture
 def fake_search(monkeypatch):
     """The search replaced by the synthetic plan (the real one is slow for now)."""
-    _, result, _ = synthetic_plan()
-
-    def plan(self, top_rung=None, progress=None):
-        for i, st in enumerate(result.step_stats):
-            progress(i, 4, result.segments[0].step, st)
-        return result
-
-    monkeypatch.setattr(ClimbPlanner, "plan", plan)
-    return result
+    return use_synthetic_search(monkeypatch)
 
 
 def test_happy_path_writes_checkable_files_and_plots(fake_search, tmp_path, capsys):

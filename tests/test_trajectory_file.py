@@ -36,14 +36,53 @@ def _fail(path, rate=25.0):
     return str(err.value)
 
 
-def test_round_trip_is_exact(tmp_path):
+@pytest.mark.parametrize("name", ["climb.traj", "climb.traj.gz"])
+def test_round_trip_is_within_a_nanoradian_then_exact(tmp_path, name):
     q = _smooth_trajectory()
     q[3, 5] += 1 / 3000  # a value with no short decimal form
-    path = tmp_path / "climb.traj"
+    q[4, 6] = -1e-13  # rounds to 0, written "0.0" (not "-0.0")
+    path = tmp_path / name
     write_trajectory(path, q)
     back = read_trajectory(path, 25.0)
     assert back.shape == (50, 40)
-    assert np.array_equal(back, q)  # bit for bit
+    assert np.abs(back - q).max() <= 0.5e-9
+    assert np.array_equal(back, np.round(q, 9) + 0.0)
+    again = tmp_path / ("again-" + name)
+    write_trajectory(again, back)
+    assert again.read_bytes() == path.read_bytes()  # what was read writes back bit for bit
+    assert max(len(v.split(".")[-1]) for v in format_trajectory(q).split()) <= 9
+
+
+def test_gz_is_the_same_text_compressed_and_deterministic(tmp_path):
+    import gzip
+
+    q = _smooth_trajectory()
+    write_trajectory(tmp_path / "a.traj.gz", q)
+    write_trajectory(tmp_path / "b.traj.gz", q)
+    write_trajectory(tmp_path / "a.traj", q)
+    raw = (tmp_path / "a.traj.gz").read_bytes()
+    assert raw[:2] == b"\x1f\x8b" and raw == (tmp_path / "b.traj.gz").read_bytes()
+    assert gzip.decompress(raw) == (tmp_path / "a.traj").read_bytes()
+    # a gzip file is read as such whatever its name; a broken one is named
+    (tmp_path / "named-plain.traj").write_bytes(raw)
+    assert np.array_equal(read_trajectory(tmp_path / "named-plain.traj", 25.0),
+                          read_trajectory(tmp_path / "a.traj", 25.0))
+    (tmp_path / "cut.traj.gz").write_bytes(raw[:40])
+    with pytest.raises(TrajectoryFileError, match="cut.traj.gz: not a readable gzip file"):
+        read_trajectory(tmp_path / "cut.traj.gz", 25.0)
+    # errors in a compressed file name its lines as in the plain one
+    lines = format_trajectory(q).splitlines()
+    lines[6] = lines[6].replace(" ", " x ", 1)
+    (tmp_path / "bad.traj.gz").write_bytes(gzip.compress(("\n".join(lines) + "\n").encode()))
+    assert "bad.traj.gz:7:" in _fail(tmp_path / "bad.traj.gz")
+
+
+def test_sidecar_of_a_gz_trajectory_sits_next_to_it():
+    from robot.plan_sidecar import sidecar_path
+
+    assert sidecar_path("out/drc.traj.gz").as_posix() == "out/drc.plan.json"
+    assert sidecar_path("out/drc.traj").as_posix() == "out/drc.plan.json"
+    assert sidecar_path("out/drc.txt").as_posix() == "out/drc.txt.plan.json"
 
 
 def test_written_lines_are_what_the_original_player_reads(tmp_path):

@@ -73,7 +73,7 @@ def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="play-trajectory", allow_abbrev=False,
                                 description=__doc__.split("\n\n")[0])
     p.add_argument("-n", dest="file", required=True, metavar="FILE",
-                   help="the 40-column trajectory file")
+                   help="the 40-column trajectory file (.gz: gzip-compressed)")
     p.add_argument("-f", dest="rate", type=int, choices=ALLOWED_RATES_HZ, metavar="HZ",
                    help="line rate: 10, 25, 50, 100, 200 or 500 Hz (default: the "
                         "sidecar's, else 25)")

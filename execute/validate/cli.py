@@ -31,7 +31,7 @@ log = logging.getLogger("validate-plan")
 
 def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="validate-plan", description=__doc__.split("\n\n")[0])
-    p.add_argument("plan", help="the 40-column trajectory (PLAN.traj); its sidecar "
+    p.add_argument("plan", help="the 40-column trajectory (PLAN.traj or PLAN.traj.gz); its sidecar "
                                "PLAN.plan.json must sit next to it")
     p.add_argument("--ladder", help="ladder name or spec file (default: the sidecar's)")
     p.add_argument("--strategy", default="mixed", choices=("mixed", "position", "pwm"),

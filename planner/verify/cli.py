@@ -25,7 +25,8 @@ __all__ = ["main"]
 
 def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="check-plan", description=__doc__.split("\n\n")[0])
-    p.add_argument("plan", help="the trajectory (OUT.traj); OUT.plan.json must sit next to it")
+    p.add_argument("plan", help="the trajectory (OUT.traj or OUT.traj.gz); OUT.plan.json must "
+                   "sit next to it")
     p.add_argument("--ladder", help="ladder name or spec file (default: the sidecar's)")
     p.add_argument("--robot", choices=("drc-hubo", "hubo2plus"),
                    help="robot (default: the sidecar's)")
