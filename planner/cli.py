@@ -128,20 +128,30 @@ def _summary_table(result, total_s: float, out) -> object:
     return t
 
 
-def _plan(args: argparse.Namespace, err) -> int:
-    from rich.progress import (
-        BarColumn,
-        MofNCompleteColumn,
-        Progress,
-        TextColumn,
-        TimeElapsedColumn,
-    )
+def _write_plots(args: argparse.Namespace, result, planner, spec, out, err, on_output) -> None:
+    """The stance plots and the snapshot strip into ``args.plots``."""
+    from ladders.render import RenderingUnavailable
+    from planner.plots import write_plan_strip, write_stance_plots
 
+    on_output("stance plots", 0, 1)
+    files = write_stance_plots(result, planner, args.plots)
+    log.info("wrote %d stance plots into %s", len(files), args.plots)
+    on_output("snapshot strip", 0, 1)
+    try:
+        strip = write_plan_strip(out.timed.configs, planner.kin, spec,
+                                 Path(args.plots) / "snapshots.png")
+        log.info("wrote %s", strip)
+    except RenderingUnavailable as exc:
+        err.print(f"plan-ladder: no snapshot strip: {exc}", markup=False)
+
+
+def _plan(args: argparse.Namespace, err) -> int:
     from ladders.loader import load_ladder
     from planner.output import write_plan
     from planner.search import ClimbPlanner, PlannerConfig, PlanningFailed
     from planner.time_limit import HARD_LIMIT_GRACE_S, TimeLimitExceeded, hard_time_limit
     from primitives.library import climb_sequence
+    from robot.progress import ProgressReporter
     from robot.text_console import text_console
 
     t0 = time.perf_counter()
@@ -159,51 +169,42 @@ def _plan(args: argparse.Namespace, err) -> int:
                          f"0..{spec.num_rungs - 1}")
     steps = climb_sequence(top)
     out_path = Path(args.out) if args.out else Path(f"{spec.name}.traj")
-    with Progress(TextColumn("{task.description:<28}"), BarColumn(), MofNCompleteColumn(),
-                  TimeElapsedColumn(), console=err, transient=False) as progress:
-        step_task = progress.add_task(f"steps: {steps[0].label}", total=len(steps))
-        rung_task = progress.add_task("rungs", total=top + 1)
+    search = ProgressReporter("plan-ladder", "search: steps", len(steps), console=err)
+    search.update(0, note=f"{steps[0].label} (rung 0 of {top})")
+    current = [steps[0]]  # the step being searched, for the time-out message
 
-        current = [steps[0]]  # the step being searched, for the time-out message
+    def on_step(i: int, n: int, step, stats) -> None:
+        current[0] = nxt = steps[min(i + 1, n - 1)]
+        search.update(i + 1, note=f"{nxt.label} (rung {nxt.rung} of {top})" if i + 1 < n
+                      else "all steps found")
+        log.info("%s done: %.2f s, %d samples, %d backtracks", step.label, stats.seconds,
+                 stats.samples, stats.backtracks)
 
-        def on_step(i: int, n: int, step, stats) -> None:
-            current[0] = steps[min(i + 1, n - 1)]
-            nxt = steps[i + 1].label if i + 1 < n else "done"
-            progress.update(step_task, completed=i + 1, description=f"steps: {nxt}")
-            done_rungs = step.rung + 1 if step.primitive.name == "straighten" else step.rung
-            progress.update(rung_task, completed=done_rungs,
-                            description=f"rungs: at rung {step.rung}")
-            log.info("%s done: %.2f s, %d samples, %d backtracks", step.label, stats.seconds,
-                     stats.samples, stats.backtracks)
-
-        try:
-            with hard_time_limit(args.time_limit + HARD_LIMIT_GRACE_S):
-                result = planner.plan(top_rung=top, progress=on_step)
-        except (PlanningFailed, TimeLimitExceeded) as exc:
-            progress.stop()
-            step, reason = ((exc.step, exc.reason) if isinstance(exc, PlanningFailed) else
-                            (current[0], f"time limit of {args.time_limit:g} s reached"))
-            err.print(f"no plan: {step.primitive.name} at rung {step.rung}: {reason}",
-                      markup=False, highlight=False, soft_wrap=True)
-            return 1
+    try:
+        with hard_time_limit(args.time_limit + HARD_LIMIT_GRACE_S):
+            result = planner.plan(top_rung=top, progress=on_step)
+    except (PlanningFailed, TimeLimitExceeded) as exc:
+        search.finish("no plan")
+        step, reason = ((exc.step, exc.reason) if isinstance(exc, PlanningFailed) else
+                        (current[0], f"time limit of {args.time_limit:g} s reached"))
+        err.print(f"no plan: {step.primitive.name} at rung {step.rung}: {reason}",
+                  markup=False, highlight=False, soft_wrap=True)
+        return 1
+    # Not "done": timing, checking and writing the plan may take minutes more.
+    search.finish(f"{len(steps)} steps found, writing the plan")
     search_s = time.perf_counter() - t0
-    out = write_plan(result, planner, out_path, args.rate,
-                     {"search_s": result.total_s, "setup_s": search_s - result.total_s},
-                     dwell_s=args.dwell)
-    if args.plots:
-        from planner.plots import write_stance_plots
+    with ProgressReporter("plan-ladder", "output", 1, console=err) as output:
+        phase = [""]
 
-        files = write_stance_plots(result, planner, args.plots)
-        log.info("wrote %d stance plots into %s", len(files), args.plots)
-        from ladders.render import RenderingUnavailable
-        from planner.plots import write_plan_strip
+        def on_output(name: str, done: int, total: int) -> None:
+            output.update(done, total=total, note=name, restart=name != phase[0])
+            phase[0] = name
 
-        try:
-            strip = write_plan_strip(out.timed.configs, planner.kin, spec,
-                                     Path(args.plots) / "snapshots.png")
-            log.info("wrote %s", strip)
-        except RenderingUnavailable as exc:
-            err.print(f"plan-ladder: no snapshot strip: {exc}", markup=False)
+        out = write_plan(result, planner, out_path, args.rate,
+                         {"search_s": result.total_s, "setup_s": search_s - result.total_s},
+                         dwell_s=args.dwell, progress=on_output)
+        if args.plots:
+            _write_plots(args, result, planner, spec, out, err, on_output)
     console = text_console()
     if not console.is_terminal:  # a log file or a pipe: keep each row on one line
         console = text_console(width=200)

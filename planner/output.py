@@ -22,7 +22,7 @@ import importlib.metadata
 import logging
 import os
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -53,6 +53,9 @@ if TYPE_CHECKING:
     from planner.timing import SegmentPath, TimedPlan
 
 log = logging.getLogger(__name__)
+
+#: ``progress(phase, done, total)``: how far `write_plan` is.
+OutputProgress = Callable[[str, int, int], None]
 
 __all__ = ["PWM_RAIL_DISTANCE_M", "PlanOutput", "arm_mode_runs", "held_palm_turn_rad",
            "palm_poses", "palm_rail_distances", "planner_version", "segment_paths", "step_groups",
@@ -330,7 +333,8 @@ def _finite(x: float) -> float | None:
 
 
 def _metrics(result: SearchResult, planner: ClimbPlanner, timed: TimedPlan,
-             segments: list[Segment], clearance_every: int) -> dict[str, Any]:
+             segments: list[Segment], clearance_every: int,
+             progress: OutputProgress | None = None) -> dict[str, Any]:
     from planner.verify.check import allowed_contacts  # the verifier's rule, shared
 
     stats = result.step_stats
@@ -345,6 +349,8 @@ def _metrics(result: SearchResult, planner: ClimbPlanner, timed: TimedPlan,
     if timed.configs is not None and clearance_every > 0:
         bounds = np.array([s.first_line for s in segments])
         for line in range(1, timed.line_count + 1, clearance_every):
+            if progress is not None and (line - 1) % (50 * clearance_every) == 0:
+                progress("clearance", line - 1, timed.line_count)
             k = int(np.searchsorted(bounds, line, side="right") - 1)
             s = segments[k]
             frac = (line - s.first_line) / max(1, s.last_line - s.first_line)
@@ -373,7 +379,8 @@ def _metrics(result: SearchResult, planner: ClimbPlanner, timed: TimedPlan,
 def write_plan(result: SearchResult, planner: ClimbPlanner, out_traj: str | os.PathLike,
                rate_hz: float = DAEMON_RATE_HZ, timings: dict[str, float] | None = None, *,
                dwell_s: float = 0.5, q_start: np.ndarray | None = None,
-               clearance_every: int = CLEARANCE_EVERY_LINES) -> PlanOutput:
+               clearance_every: int = CLEARANCE_EVERY_LINES,
+               progress: OutputProgress | None = None) -> PlanOutput:
     """Time the plan, write ``OUT.traj`` and ``OUT.plan.json``.
 
     Args:
@@ -388,6 +395,8 @@ def write_plan(result: SearchResult, planner: ClimbPlanner, out_traj: str | os.P
         q_start: configuration before the first segment; the planner's start
             configuration if None.
         clearance_every: measure the clearance metric on every n-th line (0: never).
+        progress: called as ``progress(phase, done, total)`` as the output goes: timing
+            (segments), palm poses (lines), clearance (lines), writing (0 of 1, 1 of 1).
 
     Returns:
         What was written.
@@ -399,8 +408,13 @@ def write_plan(result: SearchResult, planner: ClimbPlanner, out_traj: str | os.P
     from planner.timing import TimingConfig, time_parameterize
     from robot.limits import joint_limits
 
+    def phase(name: str, done: int, total: int) -> None:
+        if progress is not None:
+            progress(name, done, total)
+
     t0 = time.perf_counter()
     kin = planner.kin
+    phase("timing", 0, len(result.segments))
     if q_start is None:
         q_start = planner.start_configuration()[0]
     paths = segment_paths(result, kin, q_start, planner.config.arm_strategy)
@@ -410,6 +424,7 @@ def write_plan(result: SearchResult, planner: ClimbPlanner, out_traj: str | os.P
     t_timed = time.perf_counter()
     after = _holds_after_steps(result, kin)
     segments = _sidecar_segments(result, timed, after)
+    phase("palm poses", 0, timed.line_count)
     palms = palm_poses(timed.configs, kin)
     distances = palm_rail_distances(palms, planner.geom)
     # A plan for rigid arms loads them beyond what a compliant arm gives: never PWM.
@@ -419,7 +434,8 @@ def write_plan(result: SearchResult, planner: ClimbPlanner, out_traj: str | os.P
                                      & comply) for side in ARMS}
     turn = held_palm_turn_rad(palms, holding)
     feedforward = arm_feedforward(result, timed, after, planner.checker)
-    metrics = _metrics(result, planner, timed, segments, clearance_every)
+    metrics = _metrics(result, planner, timed, segments, clearance_every, progress)
+    phase("writing", 0, 1)
     metrics["palm_rail_pwm_distance_m"] = PWM_RAIL_DISTANCE_M
     metrics["max_held_palm_turn_rad"] = {side: float(turn[side].max()) for side in ARMS}
     metrics["max_held_palm_turn_line"] = {side: int(np.argmax(turn[side])) + 1 for side in ARMS}
@@ -442,6 +458,7 @@ def write_plan(result: SearchResult, planner: ClimbPlanner, out_traj: str | os.P
         planner_version=planner_version(), arm_feedforward=feedforward)
     side_path = sidecar_path(out_traj)
     write_sidecar(side_path, sidecar)
+    phase("writing", 1, 1)
     log.info("wrote %s (%d lines, %.1f s) and %s", out_traj, timed.line_count,
              timed.duration_s, side_path)
     return PlanOutput(out_traj, side_path, sidecar, timed, paths)

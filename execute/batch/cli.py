@@ -186,15 +186,6 @@ def run(opts: dict, console, err, functions=None, engine=None) -> int:
         functions: job functions (`execute.batch.jobs.JobFunctions`; default the real ones).
         engine: an engine to use instead of opening ``opts['engine']`` (tests).
     """
-    from rich.progress import (
-        BarColumn,
-        MofNCompleteColumn,
-        Progress,
-        TextColumn,
-        TimeElapsedColumn,
-        TimeRemainingColumn,
-    )
-
     from execute.batch.engine import open_engine
     from execute.batch.jobs import DEFAULT_JOB_FUNCTIONS, expand_jobs, run_label
     from execute.batch.report import (
@@ -204,6 +195,7 @@ def run(opts: dict, console, err, functions=None, engine=None) -> int:
         write_markdown,
     )
     from execute.batch.runner import RESULTS_FILE, run_batch
+    from robot.progress import ProgressReporter
 
     plans, validations = expand_jobs(opts["ladders"], opts["seeds"], opts["strategies"],
                                      opts["perturb"], opts["draws"], robot=opts["robot"],
@@ -217,20 +209,16 @@ def run(opts: dict, console, err, functions=None, engine=None) -> int:
                                                         opts["address"])
     err.print(f"batch-eval: {len(plans)} plan and {len(validations)} validate jobs on "
               f"{eng.description}; results in {out / RESULTS_FILE}", highlight=False)
-    with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
-                  TimeElapsedColumn(), TextColumn("ETA"), TimeRemainingColumn(),
-                  console=err, transient=False) as progress:
-        task = progress.add_task("jobs", total=None)
-
+    with ProgressReporter("batch-eval", "jobs", 0, console=err) as progress:
         def on_start(total: int, skipped: int) -> None:
             if skipped:
                 err.print(f"resuming: {skipped} job(s) already finished, {total} to run",
                           highlight=False)
-            progress.update(task, total=total)
+            progress.update(0, total=total, restart=True)
 
         def on_record(rec: dict) -> None:
             status = rec.get("outcome") if rec["status"] == "ok" else "error"
-            progress.update(task, advance=1, description=f"jobs (last: {rec['key']} {status})")
+            progress.update(progress.done + 1, note=f"last: {rec['key']} {status}")
 
         try:
             batch = run_batch(plans, validations, out, eng,

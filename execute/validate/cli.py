@@ -133,6 +133,7 @@ def _run(args: argparse.Namespace) -> int:
     from execute.validate.simulate import SimulationOptions, simulate
     from ladders.loader import load_ladder
     from robot.plan_sidecar import read_sidecar, sidecar_path
+    from robot.progress import ProgressReporter
     from robot.trajectory_file import read_trajectory
 
     plan = Path(args.plan)
@@ -153,7 +154,10 @@ def _run(args: argparse.Namespace) -> int:
                              placement=PlacementError.parse(args.placement_error),
                              board=board_cfg, closed_loop=not args.open_loop,
                              motion=motion_config(args))
-    run = simulate(traj, sidecar, ladder, opts, robot)
+    with ProgressReporter("validate-plan", "simulated s", len(traj) / sidecar.rate_hz,
+                          show=lambda done, total: f"{done:.1f}/{total:.1f}") as progress:
+        run = simulate(traj, sidecar, ladder, opts, robot,
+                       progress=lambda sim_s, total_s: progress.update(sim_s, total=total_s))
     metrics = compute_metrics(run)
     comparison = compare_with_plan(run, traj, ladder)
     result = result_json(run, metrics, str(plan), comparison)

@@ -27,6 +27,7 @@ from __future__ import annotations
 import logging
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -51,6 +52,8 @@ __all__ = ["STRATEGIES", "SimulationLog", "SimulationOptions", "SimulationRun", 
 log = logging.getLogger(__name__)
 
 STRATEGIES = tuple(ArmStrategy)
+#: The least wall time between two calls of `simulate`'s progress callback [s].
+PROGRESS_PERIOD_S = 0.5
 
 
 @dataclass(frozen=True)
@@ -179,8 +182,8 @@ class _Recorder:
 
 
 def simulate(trajectory_rad: np.ndarray, sidecar: PlanSidecar, ladder: LadderSpec,
-             options: SimulationOptions | None = None, robot: str = "drc-hubo"
-             ) -> SimulationRun:
+             options: SimulationOptions | None = None, robot: str = "drc-hubo",
+             progress: Callable[[float, float], None] | None = None) -> SimulationRun:
     """Play a trajectory in MuJoCo through the player, the control law and the boards.
 
     Args:
@@ -189,6 +192,9 @@ def simulate(trajectory_rad: np.ndarray, sidecar: PlanSidecar, ladder: LadderSpe
         ladder: the ladder the plan was made for (the placement error is applied here).
         options: strategy, misplacement, battery...
         robot: robot name.
+        progress: called as ``progress(simulated_s, expected_s)`` at most
+            `PROGRESS_PERIOD_S` apart in wall time (the expected length: the plan and the
+            settling time; the motion layer's pauses may run past it).
 
     The sidecar's arm feed-forward is played under every strategy; it acts only on
     joints in PWM mode.
@@ -228,7 +234,8 @@ def simulate(trajectory_rad: np.ndarray, sidecar: PlanSidecar, ladder: LadderSpe
     line_index = 0
     finished_at = stopped_at = None
     k = 0
-    wall0 = time.perf_counter()
+    wall0 = wall_report = time.perf_counter()
+    expected_s = player.duration_s + opt.verdict.settle_s
     while True:
         now = k * TICK_S
         pos_now = board.joint_pos()
@@ -245,6 +252,10 @@ def simulate(trajectory_rad: np.ndarray, sidecar: PlanSidecar, ladder: LadderSpe
         trips, grasps = board.step()
         rec.add(board, out, line_index, d.subtree_com[pelvis], sole_sites, trips, grasps)
         k += 1
+        if progress is not None and k % 100 == 0 and \
+                time.perf_counter() - wall_report >= PROGRESS_PERIOD_S:
+            wall_report = time.perf_counter()
+            progress(board.time_s, expected_s)
         if failure is None:
             failure = monitor.check(board.time_s, line_index, trips, grasps)
             if failure is not None:

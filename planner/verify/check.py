@@ -40,7 +40,7 @@ from __future__ import annotations
 
 import logging
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from types import SimpleNamespace
 from typing import TYPE_CHECKING, NamedTuple
@@ -72,6 +72,8 @@ LIMIT_TOL_RAD = 1e-9
 #: Clearance (a slow distance query) is measured on every this-many-th line, by check-plan
 #: and for the plan's own clearance metric (planner.output), so the two compare.
 CLEARANCE_EVERY_LINES = 20
+#: check_plan reports its progress every this many lines.
+PROGRESS_EVERY_LINES = 100
 CHECKS = ("joint limits", "velocity", "holds", "collision", "stability margin",
           "torque ratio", "contact wrench")
 _FRAME = {"left_hand": "L_palm", "right_hand": "R_palm", "left_foot": "L_sole",
@@ -378,8 +380,8 @@ def planned_loads(traj_rad: np.ndarray, sidecar: PlanSidecar, spec, lines: Seque
 
 
 def check_plan(traj_rad: np.ndarray, sidecar: PlanSidecar, spec, robot: str | None = None,
-               rate_hz: float | None = None, every: int = 1, where: str = "plan"
-               ) -> list[CheckResult]:
+               rate_hz: float | None = None, every: int = 1, where: str = "plan",
+               progress: Callable[[int, int], None] | None = None) -> list[CheckResult]:
     """Run every check on a trajectory and its sidecar.
 
     Args:
@@ -392,6 +394,8 @@ def check_plan(traj_rad: np.ndarray, sidecar: PlanSidecar, spec, robot: str | No
             first and last line of every segment); limits and holds are always checked
             on every line.
         where: the plan's name, for messages.
+        progress: called as ``progress(lines_done, lines)`` every `PROGRESS_EVERY_LINES`
+            lines and at the end.
 
     Returns:
         One result per check, in `CHECKS` order.
@@ -421,6 +425,8 @@ def check_plan(traj_rad: np.ndarray, sidecar: PlanSidecar, spec, robot: str | No
     prev_out: _Statics | None = None
     for k in range(n):
         line = k + 1
+        if progress is not None and k % PROGRESS_EVERY_LINES == 0:
+            progress(k, n)
         si = int(seg_of[k])
         seg = segs[si]
         label = f"{seg.primitive}/{seg.phase}"
@@ -437,6 +443,8 @@ def check_plan(traj_rad: np.ndarray, sidecar: PlanSidecar, spec, robot: str | No
         if key != prev_key or prev_out is None:  # else a dwell line: the same as before
             prev_key, prev_out = key, _statics_at(v, q, segs, si, line)
         _offer_statics(res, line, label, prev_out, v.stance(si, seg).balance_limbs)
+    if progress is not None:
+        progress(n, n)
     return [res[c] for c in CHECKS]
 
 

@@ -94,6 +94,7 @@ def main(argv: list[str] | None = None) -> int:
 def _check(args: argparse.Namespace) -> int:
     """Check the plan of ``args``, print the table; the exit code (1: a check fails)."""
     from robot.plan_sidecar import read_sidecar, sidecar_path
+    from robot.progress import ProgressReporter
     from robot.text_console import text_console
 
     err = text_console(stderr=True)
@@ -108,7 +109,9 @@ def _check(args: argparse.Namespace) -> int:
     rate = args.rate or sidecar.rate_hz
     spec = _ladder(args, sidecar, str(side))
     traj = _read(path, rate, robot)
-    results = check_plan(traj, sidecar, spec, robot, rate, args.every, str(path))
+    with ProgressReporter("check-plan", "lines", len(traj)) as progress:
+        results = check_plan(traj, sidecar, spec, robot, rate, args.every, str(path),
+                             progress=lambda done, _n: progress.update(done))
     out = text_console()
     if not out.is_terminal:  # a log file or a pipe: keep each row on one line
         out = text_console(width=200)
