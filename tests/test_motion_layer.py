@@ -213,3 +213,24 @@ def test_validate_plan_reports_the_loop_and_what_the_layer_did(reach, tmp_path, 
     assert o["motion"] is None
     assert c["motion"]["counts"]["grasp verified"] == 2
     assert {e["kind"] for e in c["motion"]["events"]} >= {"grasp verified"}
+
+
+def test_the_layers_arm_gains_are_inside_the_safety_limits():
+    """The compliant arms' clamps go to the safety ceiling (< 8 %), nothing else moves."""
+    from daemon.pwm import default_drc_gains
+    from execute.motion.gains import motion_pwm_gains
+    from robot.pwm_gains import MAX_PWM_LIMIT_PCT
+
+    base, gains = default_drc_gains(), motion_pwm_gains()
+    arm = [JOINT_INDEX[n] for side in ARM_JOINTS.values() for n in side]
+    clamped = [j for j in arm if base.max_pwm_pct[j] > 0]
+    assert np.all(gains.max_pwm_pct < MAX_PWM_LIMIT_PCT)
+    assert np.all(gains.max_pwm_pct[clamped] >= base.max_pwm_pct[clamped])
+    assert gains.max_pwm_pct[JOINT_INDEX["LWP"]] > 1.9 * base.max_pwm_pct[JOINT_INDEX["LWP"]]
+    others = np.setdiff1d(np.arange(NUM_JOINTS), clamped)
+    assert np.array_equal(gains.max_pwm_pct[others], base.max_pwm_pct[others])
+    assert np.array_equal(gains.kp, base.kp) and np.array_equal(gains.kd, base.kd)
+    from daemon.pwm import PwmGainError
+
+    with pytest.raises(PwmGainError):
+        motion_pwm_gains(8.5)

@@ -3,7 +3,8 @@
 It sits between the trajectory player and the daemon's control law, and rebuilds what
 hubo-motion-rt and the thesis's operator did (thesis §4.3.4, §6.2):
 
-- **gravity compensation** of the compliant arms (`execute.motion.gravity_compensation`);
+- **gravity compensation** of the compliant arms (`execute.motion.gravity_compensation`),
+  which run with their PWM clamps at the safety ceiling (`execute.motion.gains`);
 - **arrival**: before a hand closes, the player waits until the encoders put its palm
   within ``arrival_tolerance_m`` of where its reference does (a PWM arm lags its
   reference), at most ``arrival_timeout_s``;
@@ -40,6 +41,7 @@ from daemon.control_modes import RefMode
 from execute.motion.config import MotionConfig
 from execute.motion.estimator import BodyEstimate, StateEstimator
 from execute.motion.events import MotionEvent, MotionEventKind, MotionStop
+from execute.motion.gains import motion_pwm_gains
 from execute.motion.grasp_check import GraspReading, read_grasp
 from execute.motion.gravity_compensation import ArmGravityCompensation
 from execute.motion.ladder_estimate import LadderEstimate, RailObservation
@@ -134,6 +136,8 @@ class MotionLayer:
         self.estimator = StateEstimator(self.model, soles, self.config.estimator)
         self.gravity = ArmGravityCompensation(self.model)
         self.wrist_relief = WristRelief(robot)
+        #: The gains the daemon should run the compliant arms with (`execute.motion.gains`).
+        self.pwm_gains = motion_pwm_gains()
         self._last_now: float | None = None
         self.ladder = LadderEstimate(self.config.max_reach_correction_m,
                                      self.config.max_reach_correction_rad)
@@ -464,6 +468,7 @@ class MotionLayer:
         return {
             "config": {"gravity_compensation": self.config.gravity_compensation,
                        "holding_arm_stiffness": self.config.holding_arm_stiffness,
+                       "arm_max_pwm_pct": float(self.pwm_gains.max_pwm_pct.max()),
                        "max_reach_correction_m": self.config.max_reach_correction_m,
                        "grasp_retries": self.config.grasp_retries},
             "counts": counts,

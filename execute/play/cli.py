@@ -29,8 +29,10 @@ from the start line (``-line N``, 1-based). With ``-i`` it first moves there smo
 With a sidecar, playback is closed loop by default: the motion layer (`execute.motion`)
 reads the daemon's ``state`` channel every tick, checks every grasp from the finger
 encoders before the plan loads it, re-reaches a miss, re-targets later reaches and
-compensates the compliant arms' gravity. If a grasp cannot be made it stops and holds
-(exit 1). ``--open-loop`` plays the file as hubo-read-trajectory did.
+compensates the compliant arms' gravity; it first sets the arms' PWM clamps to the
+safety ceiling on the daemon's ``pwm-gains`` channel (`execute.motion.gains`). If a
+grasp cannot be made it stops and holds (exit 1). ``--open-loop`` plays the file as
+hubo-read-trajectory did.
 
 It streams one ``ref`` sample per 5 ms (absolute deadlines), ``playing`` set, and shows
 the line, the time and the arms' modes. With ``-p``: the ``p`` key (when stdin is a
@@ -221,6 +223,22 @@ class _Keys:
         termios.tcsetattr(self.fd, termios.TCSADRAIN, self._saved)
 
 
+def _send_gains(gains, instance: str) -> None:
+    """Write the motion layer's arm gains on the daemon's ``pwm-gains`` channel (the
+    daemon checks them against the safety limits like any writer's)."""
+    from daemon.channels import open_channel
+    from daemon.structs import PWM_GAINS_DTYPE, new_sample
+
+    channel = open_channel("pwm-gains", instance)
+    try:
+        sample = new_sample(PWM_GAINS_DTYPE)
+        sample["kp"], sample["kd"] = gains.kp, gains.kd
+        sample["max_pwm"], sample["pwm_command"] = gains.max_pwm_pct, gains.pwm_command_pct
+        channel.write(sample)
+    finally:
+        channel.close()
+
+
 def _play(args, traj, player, auto, motion=None) -> int:
     from daemon.channels import open_channel
     from daemon.loop import sleep_until_ns
@@ -238,6 +256,8 @@ def _play(args, traj, player, auto, motion=None) -> int:
         s = _wait_for_daemon(state, args.instance)
         if not args.init:
             _check_start(traj, args.line, np.asarray(s["pos"]), args.line_tolerance)
+        if motion is not None:
+            _send_gains(motion.pwm_gains, args.instance)
 
         def on_stop(signum, frame):
             flags["stop"] = True

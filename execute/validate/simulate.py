@@ -63,7 +63,8 @@ class SimulationOptions:
         placement: misplacement of the real ladder relative to the plan's.
         board: board-model tunables (battery voltage, trips, grip).
         verdict: verdict thresholds.
-        gains: PWM gains (`daemon.pwm.default_drc_gains` when None).
+        gains: PWM gains (when None: the motion layer's closed loop,
+            `daemon.pwm.default_drc_gains` open loop).
         stop_on_failure: end the run at the first failure.
         record_qpos: keep every tick's qpos (for snapshots and video).
         closed_loop: play through the motion layer (`execute.motion`), on the state
@@ -217,7 +218,7 @@ def simulate(trajectory_rad: np.ndarray, sidecar: PlanSidecar, ladder: LadderSpe
                                                             compliant_arms=compliant),
                               schedule, sidecar.arm_feedforward)
     controller = JointController(robot=robot)
-    gains = opt.gains or default_drc_gains()
+
     monitor = VerdictMonitor(board, sidecar, T_err, opt.verdict)
     motion = None
     state = new_sample(STATE_DTYPE)
@@ -225,6 +226,7 @@ def simulate(trajectory_rad: np.ndarray, sidecar: PlanSidecar, ladder: LadderSpe
         from execute.motion.layer import MotionLayer  # pinocchio: only when closing the loop
 
         motion = MotionLayer(player, trajectory_rad, sidecar, ladder, robot, opt.motion)
+    gains = opt.gains or (default_drc_gains() if motion is None else motion.pwm_gains)
     rec = _Recorder(int(math.ceil((player.duration_s + opt.verdict.settle_s) / TICK_S)),
                     board.model.nq if opt.record_qpos else 0)
     d = board.data
