@@ -105,6 +105,20 @@ def test_trip_needs_sustained_overload():
     assert not mon.tripped[JOINT_INDEX["REB"]]
 
 
+def test_trip_message_names_the_threshold_used():
+    """A torque just under the limit trips at 99% of it; the message says so."""
+    limit = np.full(NUM_JOINTS, 60.0)
+    mon = BoardTripMonitor(limit)
+    tau = np.zeros(NUM_JOINTS)
+    tau[JOINT_INDEX["LKN"]] = 59.9
+    events = []
+    for k in range(101):
+        events += mon.update(tau, 0.005, k * 0.005)
+    assert events[0].threshold_nm == 0.99 * 60.0
+    assert "LKN held |τ| ≥ 59.4 N·m (99% of its 60 N·m limit) for 0.50 s (peak 59.9 N·m)" \
+        in str(events[0])
+
+
 def test_fingers_stalling_do_not_trip_but_their_wrist_roll_does():
     limit = joint_limits().torque_max_nm
     mon = BoardTripMonitor(limit)

@@ -180,6 +180,7 @@ def test_a_slipping_grip_moves_its_anchor_to_leave_the_capacity(latched_run):
     axis = latch._rail_axis(latch.rail)
     eq = latch.model.eq_data[latch.eq_id]
     slipped_rad, slipped_m = latch.slip_rad, latch.slip_m
+    net = (latch._grasp_turn_rad, latch._grasp_slide_m)
     saved = eq.copy()
     turn = np.zeros(4)
     mujoco.mju_axisAngle2Quat(turn, axis, 0.03)  # the anchor 0.03 rad and 4 mm off
@@ -196,6 +197,11 @@ def test_a_slipping_grip_moves_its_anchor_to_leave_the_capacity(latched_run):
         assert after == pytest.approx((before[0] / 2, before[1] / 2), rel=1e-3)
         assert latch.slip_rad - slipped_rad == pytest.approx(abs(before[0]) / 2, rel=1e-3)
         assert latch.slip_m - slipped_m == pytest.approx(abs(before[1]) / 2, rel=1e-3)
+        # this grasp's net turn and slide moved by the same, signed
+        assert abs(latch._grasp_turn_rad - net[0]) == pytest.approx(abs(before[0]) / 2,
+                                                                     rel=1e-3)
+        assert abs(latch._grasp_slide_m - net[1]) == pytest.approx(abs(before[1]) / 2, rel=1e-3)
+        assert latch.max_grasp_turn_rad >= abs(latch._grasp_turn_rad)
     finally:
         eq[:] = saved
 
@@ -221,5 +227,8 @@ def test_a_grip_turns_on_its_rail_and_holds(plan):
     events = _hold(run, 100, _holding_ref(run.board), record, limp_arm="right")
     assert not events and latch.latched
     assert latch.slip_rad > 0.0
-    assert compute_metrics(run).hand_turn_on_rail_rad["right"] == latch.slip_rad
+    metrics = compute_metrics(run)
+    turn_deg = metrics.max_hand_turn_per_grasp_deg["right"]
+    assert 0.0 < turn_deg == pytest.approx(np.degrees(latch.max_grasp_turn_rad))
+    assert latch.max_grasp_turn_rad <= latch.slip_rad + 1e-12  # net of one grasp ≤ the sum
     assert max(about_rail) == pytest.approx(1.0, abs=0.05)

@@ -63,7 +63,9 @@ class BoardTripConfig:
 class TripEvent:
     """A board tripped at ``time_s`` because ``joint`` was overloaded for ``overload_s``.
 
-    ``peak_torque_nm`` is that joint's largest |τ| since the simulation started.
+    ``peak_torque_nm`` is that joint's largest |τ| since the simulation started;
+    ``threshold_nm`` the |τ| it was held at or above (``saturation_fraction`` of
+    ``torque_limit_nm``).
     """
 
     board: str
@@ -72,11 +74,15 @@ class TripEvent:
     overload_s: float
     torque_limit_nm: float
     peak_torque_nm: float
+    threshold_nm: float | None = None
 
     def __str__(self) -> str:
+        limit = self.torque_limit_nm
+        held = self.threshold_nm if self.threshold_nm is not None else limit
+        of = (f"{held:.3g} N·m ({held / limit:.0%} of its {limit:g} N·m limit)"
+              if limit > 0 and held != limit else f"its {limit:g} N·m limit")
         return (f"board {self.board} tripped at t = {self.time_s:.2f} s: {self.joint} held "
-                f"|τ| ≥ its {self.torque_limit_nm:g} N·m limit for {self.overload_s:.2f} s "
-                f"(peak {self.peak_torque_nm:.1f} N·m)")
+                f"|τ| ≥ {of} for {self.overload_s:.2f} s (peak {self.peak_torque_nm:.1f} N·m)")
 
 
 class BoardTripMonitor:
@@ -131,7 +137,8 @@ class BoardTripMonitor:
                 continue
             name = self._board_names[b]
             ev = TripEvent(name, JOINT_NAMES[j], time_s, float(self.overload_s[j]),
-                           float(self.torque_max_nm[j]), float(self.peak_torque_nm[j]))
+                           float(self.torque_max_nm[j]), float(self.peak_torque_nm[j]),
+                           float(self._overload_nm[j]))
             new.append(ev)
             for jn in BOARDS[name]:
                 self.tripped[JOINT_INDEX[jn]] = True

@@ -39,7 +39,8 @@ along it once the load in that direction exceeds what friction holds, as a real 
 does; the fingers stay round the rail. Each tick such a load is over capacity, the
 weld's anchor is moved about (or along) the rail, by the share of the hand's offset
 from it that leaves the weld's spring carrying only the capacity. `slip_rad` and
-`slip_m` add up how far the hand turned and slid.
+`slip_m` add up how far the hand turned and slid; `max_grasp_turn_rad` and
+`max_grasp_slide_m` are the largest net turn and slide of one grasp (from its latch on).
 
 The fingers close round the rail and press it with the grip's ``finger_squeeze_nm`` each, 1 N·m by
 default, a fifth of their limit:
@@ -210,6 +211,10 @@ class GraspLatch:
         self.rail: str | None = None
         self._overload_s = 0.0
         self.slip_m = self.slip_rad = 0.0
+        #: The largest net turn about [rad] and slide along [m] its rail of one grasp,
+        #: over the grasps so far (signed slips of a grasp add up; the sums above do not).
+        self.max_grasp_turn_rad = self.max_grasp_slide_m = 0.0
+        self._grasp_turn_rad = self._grasp_slide_m = 0.0
         self.peak_utilisation = 0.0
         self.last_utilisation = (0.0, "")
         #: (time [s], force [N], torque [N·m]) of the grip's load, world frame, every
@@ -343,6 +348,8 @@ class GraspLatch:
             shift_m = offset_m * (1.0 - 1.0 / u_along)
             eq[0:3] += R_l.T @ (axis * shift_m)
             self.slip_m += abs(shift_m)
+            self._grasp_slide_m += shift_m
+            self.max_grasp_slide_m = max(self.max_grasp_slide_m, abs(self._grasp_slide_m))
         if u_about > 1.0:
             q_lad = d.xquat[self.ladder_body]
             q_anchor, q_err, turn = np.zeros(4), np.zeros(4), np.zeros(4)
@@ -355,6 +362,8 @@ class GraspLatch:
             mujoco.mju_mulQuat(q_anchor, turn, q_anchor.copy())
             eq[6:10] = self._relpose(q_anchor)
             self.slip_rad += abs(turn_rad)
+            self._grasp_turn_rad += turn_rad
+            self.max_grasp_turn_rad = max(self.max_grasp_turn_rad, abs(self._grasp_turn_rad))
 
     def _relpose(self, q_hand: np.ndarray) -> np.ndarray:
         """The weld's relpose quaternion that holds the hand at orientation ``q_hand``:
@@ -387,6 +396,7 @@ class GraspLatch:
         self.state = GripState.LATCHED
         self.rail = rail
         self._overload_s = 0.0
+        self._grasp_turn_rad = self._grasp_slide_m = 0.0
 
     def _release(self, time_s: float, reason: str, new_state: GripState) -> GraspEvent:
         rail = self.rail

@@ -84,6 +84,57 @@ def motion_summary(report: dict) -> str:
     return f"motion layer: {done}; ladder estimated {shift} cm off the plan"
 
 
+#: What to try next, by failure cause (`verdict_lines`).
+NEXT_STEP = {
+    "board_trip": "the plan loads that joint to its limit: check-plan's torque ratio near that "
+                  "line; re-plan with a lower --max-torque-ratio or another --seed",
+    "fall": "the robot lost its balance: check-plan's stability margin near that line; "
+            "re-plan with a larger --foot-cop-margin or another --seed",
+    "hard_contact": "a body the plan keeps off the ladder hit it: check-plan's collision "
+                    "check near that line; re-plan with another --seed",
+    "grasp_not_latched": "the hand missed its rail: the closed loop corrects reaches up to "
+                         "--max-reach-correction with --grasp-retries; see --plots "
+                         "snapshots at that time",
+    "grasp_lost": "the grip let go under its load: re-plan with another --seed or "
+                  "--position-torque-share; the JSON's plan_vs_sim has the hold forces",
+    "final_stance": "the robot ended off its final holds: see --plots snapshots at the end",
+    "grasp_unverified": "the motion layer stopped (the JSON's motion section says why); "
+                        "--open-loop plays the file as the thesis did",
+}
+#: The longest cause line printed; the full text is the JSON's ``why``.
+CAUSE_CHARS = 160
+
+
+def verdict_lines(run, metrics, sidecar) -> list[str]:
+    """The printed verdict: a few short lines (verdict, cause, when and where, what to try
+    next, key figures); `result_json` keeps the whole explanation."""
+    v = run.verdict
+    total = (sidecar.ladder.get("geometry") or {}).get("num_rungs")
+    rungs = f"climbed {metrics.rungs_climbed}" + (f" of {total}" if total else "") + " rungs"
+    turn = max(metrics.max_hand_turn_per_grasp_deg.values(), default=0.0)
+    margin = metrics.min_com_margin_m
+    figures = (f"figures: {rungs}; peak torque {metrics.peak_torque_ratio:.0%} of the limit "
+               f"({metrics.peak_torque_joint}); largest hand turn on a rail {turn:.0f}° per "
+               f"grasp; min CoM margin " + ("n/a" if margin is None else
+                                           f"{margin * 100:.1f} cm at line "
+                                           f"{metrics.min_com_margin_line}"))
+    if v.climbed:
+        held = len(v.final_holds)
+        return ["verdict: climbed",
+                f"holds:   every final hold in contact ({held} of {held})",
+                f"time:    {run.simulated_s:.1f} s simulated, {metrics.lines_played:,} lines",
+                figures]
+    f = v.failure
+    cause = f.why if len(f.why) <= CAUSE_CHARS else f.why[:CAUSE_CHARS - 1].rstrip() + "…"
+    seg = sidecar.segment_at(min(max(f.line, 1), sidecar.line_count))
+    return [f"verdict: failed ({f.cause})",
+            f"cause:   {cause}",
+            f"when:    t = {f.time_s:.2f} s, line {f.line:,} of {sidecar.line_count:,} "
+            f"({seg.primitive}@rung{seg.rung}, {seg.phase} phase)",
+            f"next:    {NEXT_STEP.get(f.cause, 'see the JSON (--json) for the full record')}",
+            figures]
+
+
 def _why(run, metrics, comparison=None) -> str:
     """A sentence from the physical quantities behind the outcome (and, for a failure,
     where the simulation had departed from the plan)."""
@@ -161,7 +212,7 @@ def _run(args: argparse.Namespace) -> int:
     metrics = compute_metrics(run)
     comparison = compare_with_plan(run, traj, ladder)
     result = result_json(run, metrics, str(plan), comparison)
-    print(f"{result['verdict']}: {result['why']}")
+    print("\n".join(verdict_lines(run, metrics, sidecar)))
     if run.motion is not None:
         print(motion_summary(run.motion))
     print(f"simulated {metrics.simulated_s:.2f} s at {metrics.real_time_factor:.1f}× real "

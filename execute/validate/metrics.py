@@ -14,11 +14,13 @@
   executor does not import); they are left out, so the figure is ``None`` when no tick
   qualifies.
 - **Hold slip**: the largest drift of a sole from where it stood at the start of a
-  segment that keeps that foot on a hold [m]; per hand, how far in all it turned about
-  and slid along its rails while latched (`daemon.sim.grasp_latch`: beyond the grip's
-  friction a closed hand slips on its rail; letting go is a verdict failure).
-- **Simulated seconds per rung**: simulated time / rungs climbed (the highest rung the
-  plan puts a foot on, +1), ``None`` when no rung is climbed.
+  segment that keeps that foot on a hold [m]; per hand, the largest net turn about its
+  rail [deg] and slide along it [m] of one grasp, from its latch to its release
+  (`daemon.sim.grasp_latch`: beyond the grip's friction a closed hand slips on its rail;
+  letting go is a verdict failure).
+- **Simulated seconds per rung**: simulated time / rungs climbed (`rungs_climbed`: the
+  highest rung a foot stood on in a segment the run played to its end, +1), ``None``
+  when the run climbed no rung.
 - **Real-time factor**: simulated time / wall time of the loop.
 """
 
@@ -31,9 +33,10 @@ import mujoco
 import numpy as np
 
 from robot.joints import ARM_JOINTS, JOINT_NAMES, joint_indices
-from robot.vocabulary import HoldTargetKind
+from robot.vocabulary import HoldTargetKind, Limb
 
-__all__ = ["RunMetrics", "compute_metrics", "line_samples", "tracking_error_by_arm"]
+__all__ = ["RunMetrics", "compute_metrics", "line_samples", "rungs_climbed",
+           "tracking_error_by_arm"]
 
 _CONTACT_SAMPLE_TICKS = 10
 
@@ -47,10 +50,13 @@ class RunMetrics:
     peak_torque_ratio: float
     peak_torque_joint: str
     min_com_margin_m: float | None
+    min_com_margin_time_s: float | None  # when that minimum was
+    min_com_margin_line: int | None  # the trajectory line then (1-based)
     max_foot_slip_m: float
-    hand_turn_on_rail_rad: dict[str, float]  # hand → total turn about its rails
-    hand_slide_on_rail_m: dict[str, float]  # hand → total slide along its rails
+    max_hand_turn_per_grasp_deg: dict[str, float]  # hand → largest net turn of one grasp
+    max_hand_slide_per_grasp_m: dict[str, float]  # hand → largest net slide of one grasp
     simulated_s: float
+    rungs_climbed: int
     simulated_s_per_rung: float | None
     real_time_factor: float
     lines_played: int
@@ -78,12 +84,14 @@ def tracking_error_by_arm(pos_rad: np.ndarray, ref_rad: np.ndarray, line_index: 
     return by_arm, by_joint
 
 
-def _com_margin(model, data, qpos_rows, com_rows, latched_rows, env_geoms) -> float | None:
+def _com_margin(model, data, qpos_rows, com_rows, latched_rows, env_geoms
+                ) -> tuple[float | None, int | None]:
+    """(smallest margin [m], its row) over the rows that qualify (module docstring)."""
     from scipy.spatial import ConvexHull, QhullError
 
-    best = None
+    best, where = None, None
     pts = []
-    for q, com, lat in zip(qpos_rows, com_rows, latched_rows, strict=True):
+    for row, (q, com, lat) in enumerate(zip(qpos_rows, com_rows, latched_rows, strict=True)):
         if lat.any():
             continue
         data.qpos[:] = q
@@ -106,8 +114,9 @@ def _com_margin(model, data, qpos_rows, com_rows, latched_rows, env_geoms) -> fl
             continue
         # hull.equations: n·x + b <= 0 inside; margin = min over edges of −(n·c + b)
         margin = float(np.min(-(hull.equations[:, :2] @ com[:2] + hull.equations[:, 2])))
-        best = margin if best is None else min(best, margin)
-    return best
+        if best is None or margin < best:
+            best, where = margin, row
+    return best, where
 
 
 def compute_metrics(run) -> RunMetrics:
@@ -122,14 +131,15 @@ def compute_metrics(run) -> RunMetrics:
         peak, peak_joint = float(ratio[k, j]), JOINT_NAMES[j]
     else:
         peak, peak_joint = 0.0, ""
-    margin = None
+    margin = margin_tick = None
     if lg.qpos is not None and len(lg.qpos):
         m = run.board.model
         d = mujoco.MjData(m)
         ladder = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "ladder")
         env = {g for g in range(m.ngeom) if m.geom_bodyid[g] in (0, ladder)}
         sel = slice(0, None, _CONTACT_SAMPLE_TICKS)
-        margin = _com_margin(m, d, lg.qpos[sel], lg.com_m[sel], lg.latched[sel], env)
+        margin, row = _com_margin(m, d, lg.qpos[sel], lg.com_m[sel], lg.latched[sel], env)
+        margin_tick = None if row is None else row * _CONTACT_SAMPLE_TICKS
     slip = 0.0
     for seg in run.sidecar.segments:
         ticks = np.flatnonzero((lg.line_index >= seg.first_line - 1) &
@@ -140,18 +150,30 @@ def compute_metrics(run) -> RunMetrics:
             if limb in seg.holds:
                 drift = np.linalg.norm(lg.sole_m[ticks, s] - lg.sole_m[ticks[0], s], axis=1)
                 slip = max(slip, float(drift.max()))
-    rungs = [seg.rung for seg in run.sidecar.segments
-             if any(h.hold_target.kind is HoldTargetKind.RUNG for h in seg.holds.values())]
-    climbed = (max(rungs) + 1) if rungs else 0
+    lines_played = int(lg.line_index.max()) + 1 if len(lg.line_index) else 0
+    climbed = rungs_climbed(run.sidecar.segments, lines_played)
     sim_s = float(run.simulated_s)
+    latches = run.board.latches.items()
     return RunMetrics(
         tracking_error_rad=by_arm, tracking_error_by_joint_rad=by_joint,
         peak_torque_ratio=peak, peak_torque_joint=peak_joint, min_com_margin_m=margin,
+        min_com_margin_time_s=None if margin_tick is None else float(lg.time_s[margin_tick]),
+        min_com_margin_line=None if margin_tick is None else int(lg.line_index[margin_tick]) + 1,
         max_foot_slip_m=slip,
-        hand_turn_on_rail_rad={h: latch.slip_rad for h, latch in run.board.latches.items()},
-        hand_slide_on_rail_m={h: latch.slip_m for h, latch in run.board.latches.items()},
-        simulated_s=sim_s,
+        max_hand_turn_per_grasp_deg={h: math.degrees(latch.max_grasp_turn_rad)
+                                     for h, latch in latches},
+        max_hand_slide_per_grasp_m={h: latch.max_grasp_slide_m for h, latch in latches},
+        simulated_s=sim_s, rungs_climbed=climbed,
         simulated_s_per_rung=sim_s / climbed if climbed else None,
         real_time_factor=float(run.real_time_factor) if math.isfinite(
             run.real_time_factor) else 0.0,
-        lines_played=int(lg.line_index.max()) + 1 if len(lg.line_index) else 0)
+        lines_played=lines_played)
+
+
+def rungs_climbed(segments, lines_played: int) -> int:
+    """Rungs a run climbed: the highest rung a foot stood on in a segment played to its
+    end, plus 1; 0 when no such segment (a run that stopped before its first rung)."""
+    rungs = [h.hold_target.rung for seg in segments if seg.last_line <= lines_played
+             for limb, h in seg.holds.items()
+             if Limb(limb).is_foot and h.hold_target.kind is HoldTargetKind.RUNG]
+    return max(rungs) + 1 if rungs else 0

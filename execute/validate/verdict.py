@@ -150,6 +150,7 @@ class VerdictMonitor:
                            {"board": ev.board, "joint": ev.joint,
                             "torque_limit_nm": ev.torque_limit_nm,
                             "peak_torque_nm": ev.peak_torque_nm,
+                            "threshold_nm": ev.threshold_nm,
                             "overload_s": ev.overload_s})
         d = self.data
         z = float(d.xpos[self.pelvis][2])
