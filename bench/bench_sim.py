@@ -1,7 +1,7 @@
 """Benchmark: real-time factor of the lock-step simulation (player → control → MuJoCo).
 
 Target: ≥ 10× real time on one core for a climb. The climb is ``plan-ladder drc --seed 6``
-(planned here, ≈ 100 s; the seed whose plan climbs, as in ``make demo``), simulated to
+(planned here, ≈ 100 s; the seed of ``make demo``), simulated to
 its end under ``mixed`` and ``position`` even after a failure (the figure is the
 simulator's speed, not the verdict; the verdict is printed).
 ``HUBO_BENCH_PLAN=path/to/plan.traj`` (with its ``.plan.json``) times another plan, and
@@ -16,7 +16,7 @@ import tempfile
 from pathlib import Path
 
 TARGET_RTF = 10.0
-#: The DRC seed whose plan climbs in MuJoCo (README, tests/test_drc_climb.py).
+#: The DRC seed of `make demo` (its whole climb, the run a user times first).
 DRC_SEED = 6
 
 
