@@ -1,6 +1,6 @@
 """Benchmark: real-time factor of the lock-step simulation (player → control → MuJoCo).
 
-Target: ≥ 10× real time on one core for a climb. The climb is ``plan-ladder drc --seed 6``
+Target: ≥ 10× real time on one core for a climb. The climb is ``plan-ladder drc --seed 4``
 (planned here, ≈ 100 s; the seed of ``make demo``), simulated to
 its end under ``mixed`` and ``position`` even after a failure (the figure is the
 simulator's speed, not the verdict; the verdict is printed).
@@ -17,7 +17,7 @@ from pathlib import Path
 
 TARGET_RTF = 10.0
 #: The DRC seed of `make demo` (its whole climb, the run a user times first).
-DRC_SEED = 6
+DRC_SEED = 4
 
 
 def _fixture_plan(tmp: str) -> Path:
