@@ -48,7 +48,7 @@ from execute.motion.ladder_estimate import LadderEstimate, RailObservation
 from execute.motion.robot_model import MotionRobotModel
 from execute.motion.sensed_state import SensedState
 from execute.motion.wrist_relief import WRIST_ROLL, WristRelief
-from execute.play.player import PlayerTick, TrajectoryPlayer
+from execute.play.player import PlayerTick, TrajectoryPlayer, min_jerk
 from ladders.geometry import LadderGeometry
 from ladders.spec import LadderSpec
 from robot.joints import ARM_JOINTS, FINGER_JOINTS, joint_indices
@@ -73,11 +73,6 @@ def _side(limb: str) -> str:
     return limb.split("_")[0]
 
 
-def _min_jerk(u: float) -> float:
-    u = min(max(u, 0.0), 1.0)
-    return u * u * u * (10.0 + u * (-15.0 + 6.0 * u))
-
-
 @dataclass
 class _Blend:
     """A limb's joint offset moving from ``start`` to ``end`` between two lines (or two
@@ -92,7 +87,7 @@ class _Blend:
     def at(self, t: float) -> np.ndarray:
         if self.t1 <= self.t0:
             return self.end
-        return self.start + _min_jerk((t - self.t0) / (self.t1 - self.t0)) * (self.end - self.start)
+        return self.start + min_jerk((t - self.t0) / (self.t1 - self.t0)) * (self.end - self.start)
 
 
 @dataclass
