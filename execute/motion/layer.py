@@ -449,7 +449,7 @@ class MotionLayer:
                     mode = tick.mode.copy()
                 mode[soft] = RefMode.DIRECT  # the share is the stiffness; no filter lag
         ff = tick.feedforward_nm
-        if self.config.gravity_compensation:
+        if self.config.gravity_compensation and tick.comply.any():  # else ff goes unused
             ff = self.gravity.feedforward_nm(ff, plan_rad, s.pos_rad, self.estimate.R_tilt)
             ff[~tick.comply] = 0.0
         return dataclasses.replace(tick, ref_rad=ref, mode=mode, feedforward_nm=ff)

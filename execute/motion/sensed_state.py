@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from daemon.structs import FT_NAMES, IMU_NAMES, STATE_DTYPE
+from daemon.structs import FT_DTYPE, FT_NAMES, IMU_DTYPE, IMU_NAMES, STATE_DTYPE
 
 __all__ = ["SensedState"]
 
@@ -55,8 +55,8 @@ class SensedState:
         if sample.dtype != STATE_DTYPE:
             raise TypeError(f"expected a state sample ({STATE_DTYPE.itemsize} bytes), got "
                             f"dtype {sample.dtype}")
-        ft = np.stack([sample["ft"][k].tolist() for k in range(len(FT_NAMES))])
-        imu = np.stack([sample["imu"][k].tolist() for k in range(len(IMU_NAMES))])
+        ft = np.column_stack([sample["ft"][f] for f in FT_DTYPE.names])
+        imu = np.column_stack([sample["imu"][f] for f in IMU_DTYPE.names])
         return cls(float(sample["time_s"]), np.array(sample["pos"], dtype=float),
                    np.array(sample["vel"], dtype=float), ft, imu,
                    np.array(sample["ref"], dtype=float), np.array(sample["cur"], dtype=float),
