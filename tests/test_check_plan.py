@@ -59,14 +59,20 @@ def test_moved_hold_fails_naming_the_line(good, tmp_path, capsys):
     assert "right_foot 5.00 cm from its hold on floor" in err
 
 
-def test_joint_past_its_limit_fails_naming_the_line(good, tmp_path, capsys):
-    bad = _copy(good, tmp_path / "limit.traj")
+def _knee_past_its_limit(good, path):
+    """A copy of ``good`` whose line 100 puts RKN 0.2 rad past its upper limit."""
+    bad = _copy(good, path)
     lines = bad.read_text().splitlines()
     cols = lines[99].split()
     k = JOINT_INDEX["RKN"]
     cols[k] = repr(float(joint_limits().upper_rad[k]) + 0.2)
     lines[99] = " ".join(cols)
     bad.write_text("\n".join(lines) + "\n")
+    return bad
+
+
+def test_joint_past_its_limit_fails_naming_the_line(good, tmp_path, capsys):
+    bad = _knee_past_its_limit(good, tmp_path / "limit.traj")
     assert main([str(bad), "--every", "50"]) == 1
     err = capsys.readouterr().err
     assert "joint limits fails at line 100: RKN" in err
@@ -150,13 +156,7 @@ def test_a_lone_compliant_hand_is_not_counted_on_for_balance():
 
 def test_failing_lines_are_counted_once(good, tmp_path, capsys):
     """One line past a limit is "1 line"; the spike makes two bad steps: "2 lines"."""
-    bad = _copy(good, tmp_path / "spike.traj")
-    lines = bad.read_text().splitlines()
-    cols = lines[99].split()
-    k = JOINT_INDEX["RKN"]
-    cols[k] = repr(float(joint_limits().upper_rad[k]) + 0.2)
-    lines[99] = " ".join(cols)
-    bad.write_text("\n".join(lines) + "\n")
+    bad = _knee_past_its_limit(good, tmp_path / "spike.traj")
     assert main([str(bad), "--every", "50"]) == 1
     out = capsys.readouterr().out
     rows = {r.split("│")[1].strip(): r for r in out.splitlines() if r.count("│") > 2}
