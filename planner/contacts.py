@@ -5,7 +5,7 @@ A foot hold is the part of the sole resting on a rung: the corners of its contac
 friction μ. A hand hold is a palm closed on a rail: a wrench contact whose limits are the
 grip's (`ladders.contact_model.HandLimits`). A hand hold without limits is the thesis's
 point hold: one contact that pushes up and one that pulls the hand towards the ladder,
-both with friction μ (the CoM tests of `planner.statics.stability` still take it).
+both with friction μ (the CoM tests of `planner.statics.com_region` still take it).
 """
 
 from __future__ import annotations

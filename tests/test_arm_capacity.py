@@ -14,7 +14,8 @@ from planner.statics.arm_capacity import (
     gripping_torque_limits,
     gripping_velocity_limits,
 )
-from planner.statics.stability import support_region, torque_feasibility, torque_limits_by_joint
+from planner.statics.com_region import support_region
+from planner.statics.torque_lp import torque_feasibility, torque_limits_by_joint
 from primitives.library import climb_sequence
 from robot.joints import ARM_JOINTS, JOINT_INDEX
 from robot.limits import joint_limits

@@ -22,7 +22,8 @@ from ladders.geometry import LadderGeometry
 from ladders.loader import load_ladder
 from planner.contacts import Hold, Stance
 from planner.holds import make_hold
-from planner.statics.stability import support_region, torque_feasibility
+from planner.statics.com_region import support_region
+from planner.statics.torque_lp import torque_feasibility
 from primitives.hold_seeds import RailSeed, RungSeed
 from robot.params import DRC_HUBO
 

@@ -1,4 +1,4 @@
-"""Static stability: friction cones, CoM support region, torque LP (planner.statics.stability)."""
+"""Static stability: friction cones, CoM support region, torque LP (planner.statics)."""
 
 from __future__ import annotations
 
@@ -10,16 +10,11 @@ import pytest
 from scipy.spatial import ConvexHull
 
 from planner.contacts import Hold, Stance
-from planner.statics.stability import (
-    StabilityConfig,
-    StabilityError,
-    SupportRegion,
-    check_stability,
-    friction_cone_edges,
-    support_region,
-    torque_feasibility,
-    torque_limits_by_joint,
-)
+from planner.statics.com_region import SupportRegion, support_region
+from planner.statics.config import StabilityConfig, StabilityError
+from planner.statics.contact_wrenches import friction_cone_edges
+from planner.statics.stability import check_stability
+from planner.statics.torque_lp import torque_feasibility, torque_limits_by_joint
 from robot.errors import HuboLadderError
 from robot.urdf import robot_urdf
 

@@ -10,7 +10,7 @@
   the convex hull of the robot's contact points, over the ticks where every contact is
   on a horizontal surface (floor or rung treads) and no hand is latched, sampled every
   10 ticks. Then the hull is the exact static support polygon. Ticks with a hand on a
-  rail have a 3-D support region (the planner's LP, `planner.statics.stability`, which the
+  rail have a 3-D support region (the planner's LP, `planner.statics.com_region`, which the
   executor does not import); they are left out, so the figure is ``None`` when no tick
   qualifies.
 - **Hold slip**: the largest drift of a sole from where it stood at the start of a

@@ -1,6 +1,6 @@
 """How much torque each arm joint can give while its hand holds a rail, per strategy.
 
-The torque LP of `planner.statics.stability` spreads the load over every joint that can carry
+The torque LP of `planner.statics.torque_lp` spreads the load over every joint that can carry
 it. Which arm joints can carry how much depends on how the arms will be driven:
 
 - ``position``: both arms rigid; every joint up to its torque limit.

@@ -56,7 +56,8 @@ from robot.vocabulary import HoldTarget, HoldTargetKind, Limb
 
 if TYPE_CHECKING:
     from planner.contacts import Hold, Stance
-    from planner.statics.stability import SupportRegion, TorqueCheck
+    from planner.statics.com_region import SupportRegion
+    from planner.statics.torque_lp import TorqueCheck
 
 __all__ = ["CHECKS", "CLEARANCE_EVERY_LINES", "CheckResult", "ContactLoad", "HOLD_TOL_M",
            "PlannedLoad",
@@ -202,7 +203,7 @@ class ContactLoad(NamedTuple):
 
 def contact_wrench_utilisation(check: TorqueCheck) -> ContactLoad:
     """The most used grip limit of a torque LP's solution
-    (`planner.statics.stability.torque_feasibility`). A foot's limits are the LP's own
+    (`planner.statics.torque_lp.torque_feasibility`). A foot's limits are the LP's own
     constraints (cones at the spec's μ at its patch's corners), which its solution meets
     with equality wherever a vertex lies: an overloaded foot shows as no equilibrium."""
     if not check.equilibrium:
@@ -235,7 +236,7 @@ class _Verifier:
         from ladders.collision import ladder_collision_objects
         from ladders.geometry import LadderGeometry
         from planner.configuration.collision import CollisionModel
-        from planner.statics.stability import torque_limits_by_joint
+        from planner.statics.torque_lp import torque_limits_by_joint
         from robot.joints import JOINT_NAMES
         from robot.params import robot_params
         from robot.urdf import robot_urdf
@@ -313,7 +314,7 @@ class _Verifier:
         planner's capacity model is robot data), cached."""
         if seg_index not in self._stances:
             from planner.contacts import Stance
-            from planner.statics.stability import support_region
+            from planner.statics.com_region import support_region
 
             stance = Stance(tuple(self.contact_hold(lb, h) for lb, h in sorted(seg.holds.items())))
             limits = gripping_torque_limits(self.torque_max, gripping_sides(seg.holds),
@@ -356,7 +357,7 @@ def planned_loads(traj_rad: np.ndarray, sidecar: PlanSidecar, spec, lines: Seque
                   robot: str | None = None) -> list[PlannedLoad]:
     """The configuration and the torque LP of each of ``lines`` (1-based), as check-plan
     computes them: what a simulation of the plan is compared against."""
-    from planner.statics.stability import torque_feasibility
+    from planner.statics.torque_lp import torque_feasibility
 
     seg_of = _segment_of_lines(sidecar, "plan")
     v = _Verifier(spec, robot or sidecar.robot, sidecar.metrics.get("arm_strategy",
@@ -523,7 +524,8 @@ def _statics_at(v: _Verifier, q: np.ndarray, segs: Sequence[Segment], si: int,
                 line: int) -> _Statics:
     """Collisions (clearance every `CLEARANCE_EVERY_LINES`), the CoM's margin, the torque
     LP and the contacts' use at ``q``, a line of segment ``si``."""
-    from planner.statics.stability import check_stability, torque_feasibility
+    from planner.statics.stability import check_stability
+    from planner.statics.torque_lp import torque_feasibility
 
     seg = segs[si]
     frac = (line - seg.first_line) / max(1, seg.last_line - seg.first_line)
