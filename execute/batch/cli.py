@@ -107,9 +107,39 @@ def parse_args(argv: list[str] | None = None) -> dict:
         SystemExit: argparse's own errors (exit 2) and ``--help`` (exit 0).
     """
     from execute.batch.perturb import parse_perturb
-    from ladders.loader import load_ladder
 
     a = _parser().parse_args(argv)
+    _check_scalar_options(a)
+    strategies = _split("--strategies", a.strategies)
+    bad = [s for s in strategies if s not in STRATEGIES]
+    if bad:
+        raise InputError(f"option --strategies: {', '.join(bad)} unknown; choose from "
+                         f"{', '.join(STRATEGIES)}")
+    loops = _split("--loop", a.loop)
+    bad = [x for x in loops if x not in LOOPS]
+    if bad or len(set(loops)) != len(loops):
+        raise InputError(f"option --loop is {a.loop!r}; give closed, open or closed,open")
+    perturb = parse_perturb(a.perturb)
+    if a.draws > 1 and not perturb:
+        raise InputError(f"option --draws is {a.draws}, but there is no --perturb: every draw "
+                         "would be the same simulation")
+    ladders = _batch_ladders(a)
+    for key, spec, _ in ladders:
+        perturb.check_ladder(spec)
+        if a.top_rung is not None and a.top_rung >= spec.num_rungs:
+            raise InputError(f"option --top-rung is {a.top_rung}; ladder '{key}' has rungs "
+                             f"0..{spec.num_rungs - 1}")
+    workers = a.workers or os.cpu_count() or 1
+    return {"ladders": ladders, "seeds": list(range(a.first_seed, a.first_seed + a.seeds)),
+            "strategies": strategies, "loops": loops, "perturb": perturb, "draws": a.draws,
+            "engine": a.engine, "address": a.address, "workers": workers, "out": Path(a.out),
+            "time_limit_s": a.time_limit, "top_rung": a.top_rung, "robot": a.robot,
+            "rate_hz": a.rate, "max_jobs": a.max_jobs, "plots": not a.no_plots,
+            "verbose": a.verbose}
+
+
+def _check_scalar_options(a: argparse.Namespace) -> None:
+    """The numeric options against their ranges, then --engine, --address and --robot."""
     for name, value, ok, rule in (
             ("--seeds", a.seeds, 1 <= a.seeds <= MAX_SEEDS, f"in [1, {MAX_SEEDS}]"),
             ("--first-seed", a.first_seed, 0 <= a.first_seed < 2**31, "in [0, 2^31)"),
@@ -134,46 +164,28 @@ def parse_args(argv: list[str] | None = None) -> dict:
                              "address like tcp://host:8786")
     if a.robot not in ("drc-hubo", "hubo2plus"):
         raise InputError(f"option --robot is {a.robot!r}; choose drc-hubo or hubo2plus")
-    strategies = _split("--strategies", a.strategies)
-    bad = [s for s in strategies if s not in STRATEGIES]
-    if bad:
-        raise InputError(f"option --strategies: {', '.join(bad)} unknown; choose from "
-                         f"{', '.join(STRATEGIES)}")
-    loops = _split("--loop", a.loop)
-    bad = [x for x in loops if x not in LOOPS]
-    if bad or len(set(loops)) != len(loops):
-        raise InputError(f"option --loop is {a.loop!r}; give closed, open or closed,open")
-    perturb = parse_perturb(a.perturb)
-    if a.draws > 1 and not perturb:
-        raise InputError(f"option --draws is {a.draws}, but there is no --perturb: every draw "
-                         "would be the same simulation")
+
+
+def _batch_ladders(a: argparse.Namespace) -> list[tuple[str, object, dict]]:
+    """The batch's ladders as (key, spec, swept values): a sweep's cells, or the
+    --ladders list (each key once)."""
+    from ladders.loader import load_ladder
+
     if a.sweep:
         from execute.batch.sweep import load_sweep
 
-        ladders = [(c.name, c.spec, c.params) for c in load_sweep(a.sweep)]
-    else:
-        ladders = []
-        for name in _split("--ladders", a.ladders or "drc"):
-            try:
-                spec = load_ladder(name)
-            except InputError as exc:
-                raise InputError(f"option --ladders: {exc}") from None
-            key = name if spec.name == name else spec.name
-            if any(k == key for k, _, _ in ladders):
-                raise InputError(f"option --ladders: two ladders are named '{key}'")
-            ladders.append((key, spec, {}))
-    for key, spec, _ in ladders:
-        perturb.check_ladder(spec)
-        if a.top_rung is not None and a.top_rung >= spec.num_rungs:
-            raise InputError(f"option --top-rung is {a.top_rung}; ladder '{key}' has rungs "
-                             f"0..{spec.num_rungs - 1}")
-    workers = a.workers or os.cpu_count() or 1
-    return {"ladders": ladders, "seeds": list(range(a.first_seed, a.first_seed + a.seeds)),
-            "strategies": strategies, "loops": loops, "perturb": perturb, "draws": a.draws,
-            "engine": a.engine, "address": a.address, "workers": workers, "out": Path(a.out),
-            "time_limit_s": a.time_limit, "top_rung": a.top_rung, "robot": a.robot,
-            "rate_hz": a.rate, "max_jobs": a.max_jobs, "plots": not a.no_plots,
-            "verbose": a.verbose}
+        return [(c.name, c.spec, c.params) for c in load_sweep(a.sweep)]
+    ladders: list[tuple[str, object, dict]] = []
+    for name in _split("--ladders", a.ladders or "drc"):
+        try:
+            spec = load_ladder(name)
+        except InputError as exc:
+            raise InputError(f"option --ladders: {exc}") from None
+        key = name if spec.name == name else spec.name
+        if any(k == key for k, _, _ in ladders):
+            raise InputError(f"option --ladders: two ladders are named '{key}'")
+        ladders.append((key, spec, {}))
+    return ladders
 
 
 def run(opts: dict, console, err, functions=None, engine=None) -> int:
@@ -186,16 +198,8 @@ def run(opts: dict, console, err, functions=None, engine=None) -> int:
         functions: job functions (`execute.batch.jobs.JobFunctions`; default the real ones).
         engine: an engine to use instead of opening ``opts['engine']`` (tests).
     """
-    from execute.batch.engine import open_engine
-    from execute.batch.jobs import DEFAULT_JOB_FUNCTIONS, expand_jobs, run_label
-    from execute.batch.report import (
-        print_summary,
-        summarize_records,
-        write_csv,
-        write_markdown,
-    )
-    from execute.batch.runner import RESULTS_FILE, run_batch
-    from robot.progress import ProgressReporter
+    from execute.batch.jobs import expand_jobs
+    from execute.batch.runner import RESULTS_FILE
 
     plans, validations = expand_jobs(opts["ladders"], opts["seeds"], opts["strategies"],
                                      opts["perturb"], opts["draws"], robot=opts["robot"],
@@ -205,6 +209,33 @@ def run(opts: dict, console, err, functions=None, engine=None) -> int:
     out: Path = opts["out"]
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
+    batch = _run_with_progress(plans, validations, opts, err, functions, engine)
+    files = _write_reports(batch, plans, validations, opts, console)
+    wall = time.perf_counter() - t0
+    err.print(f"ran {batch.ran} job(s), skipped {batch.skipped} finished, in {wall:.1f} s; "
+              f"wrote {', '.join(str(f) for f in files)}", highlight=False, soft_wrap=True)
+    missing = len(plans) + len(validations) - len(batch.records)
+    if missing:
+        err.print(f"{missing} job(s) not run yet; run the same command again to continue",
+                  highlight=False)
+    if batch.errors:
+        err.print(f"{len(batch.errors)} job(s) errored (recorded in {out / RESULTS_FILE}); "
+                  f"first: {batch.errors[0]['key']}: {batch.errors[0].get('error')}",
+                  markup=False, highlight=False, soft_wrap=True)
+        return 1
+    return 0
+
+
+def _run_with_progress(plans, validations, opts: dict, err, functions, engine):
+    """`execute.batch.runner.run_batch` on the engine (opened here unless given), with a
+    progress bar on ``err``; an engine opened here is closed, cancelling queued jobs if
+    the run is interrupted."""
+    from execute.batch.engine import open_engine
+    from execute.batch.jobs import DEFAULT_JOB_FUNCTIONS
+    from execute.batch.runner import RESULTS_FILE, run_batch
+    from robot.progress import ProgressReporter
+
+    out: Path = opts["out"]
     eng = engine if engine is not None else open_engine(opts["engine"], opts["workers"],
                                                         opts["address"])
     err.print(f"batch-eval: {len(plans)} plan and {len(validations)} validate jobs on "
@@ -231,6 +262,21 @@ def run(opts: dict, console, err, functions=None, engine=None) -> int:
             raise
         if engine is None:
             eng.close()
+    return batch
+
+
+def _write_reports(batch, plans, validations, opts: dict, console) -> list[Path]:
+    """The success table: printed, ``summary.csv``, ``summary.md`` and (unless
+    ``--no-plots``) the plots; returns the files written."""
+    from execute.batch.jobs import run_label
+    from execute.batch.report import (
+        print_summary,
+        summarize_records,
+        write_csv,
+        write_markdown,
+    )
+
+    out: Path = opts["out"]
     expected: dict[tuple[str, str], int] = {}
     for v in validations:
         k = (v.plan.ladder_key, v.label)
@@ -247,19 +293,7 @@ def run(opts: dict, console, err, functions=None, engine=None) -> int:
         from execute.batch.plots import write_plots
 
         files += write_plots(summary, out / "plots")
-    wall = time.perf_counter() - t0
-    err.print(f"ran {batch.ran} job(s), skipped {batch.skipped} finished, in {wall:.1f} s; "
-              f"wrote {', '.join(str(f) for f in files)}", highlight=False, soft_wrap=True)
-    missing = len(plans) + len(validations) - len(batch.records)
-    if missing:
-        err.print(f"{missing} job(s) not run yet; run the same command again to continue",
-                  highlight=False)
-    if batch.errors:
-        err.print(f"{len(batch.errors)} job(s) errored (recorded in {out / RESULTS_FILE}); "
-                  f"first: {batch.errors[0]['key']}: {batch.errors[0].get('error')}",
-                  markup=False, highlight=False, soft_wrap=True)
-        return 1
-    return 0
+    return files
 
 
 class BatchSetupError(HuboLadderError):

@@ -102,8 +102,46 @@ def run_batch(plans: Sequence[PlanJob], validations: Sequence[ValidateJob],
     """
     t_start = time.perf_counter()
     out = Path(out_dir)
-    out_s = str(out)
     results = ResultsLog(out / RESULTS_FILE)
+    pending = _pending_jobs(plans, validations, results, out)
+    if on_start is not None:
+        on_start(pending.to_run, pending.skipped)
+    scheduler = _Scheduler(pending, results, engine, functions, str(out), on_record)
+    for key in list(pending.waiting):
+        if key in pending.plan_done:
+            scheduler.release(key)
+    scheduler.run(max_jobs)
+
+    records = [results.latest[j.key] for j in [*plans, *validations] if j.key in results.latest]
+    return BatchRun(records, pending.skipped, scheduler.ran, time.perf_counter() - t_start,
+                    engine.description, [r for r in records if r.get("status") == "error"])
+
+
+@dataclass
+class _Pending:
+    """What the results file leaves of a batch to run.
+
+    Attributes:
+        plan_done: the record of every plan job already finished, by job key.
+        ready: jobs that can run now (the unfinished plan jobs, at first).
+        waiting: unfinished validate jobs by the key of the plan job they need.
+        skipped: jobs finished in the results file.
+    """
+
+    plan_done: dict[str, dict]
+    ready: deque
+    waiting: dict[str, list[ValidateJob]]
+    skipped: int
+
+    @property
+    def to_run(self) -> int:
+        return len(self.ready) + sum(len(vs) for vs in self.waiting.values())
+
+
+def _pending_jobs(plans: Sequence[PlanJob], validations: Sequence[ValidateJob],
+                  results: ResultsLog, out: Path) -> _Pending:
+    """Sort the batch's jobs by the results file: a plan job counts as finished only if
+    its trajectory is still on disk (a validate job needs it)."""
     plan_done: dict[str, dict] = {}
     ready: deque = deque()
     for p in plans:
@@ -120,104 +158,123 @@ def run_batch(plans: Sequence[PlanJob], validations: Sequence[ValidateJob],
             skipped += 1
         else:
             waiting.setdefault(v.plan.key, []).append(v)
-    to_run = len(ready) + sum(len(vs) for vs in waiting.values())
-    if on_start is not None:
-        on_start(to_run, skipped)
+    return _Pending(plan_done, ready, waiting, skipped)
 
-    ran = 0
 
-    def record(job, status: str, fields: dict) -> None:
-        nonlocal ran
+class _Scheduler:
+    """Keeps at most ``engine.slots`` jobs in flight and records each as it ends.
+
+    A plan job's end releases its validate jobs to the front of the queue. After a broken
+    pool, the jobs that were in flight are suspects, re-run one at a time (``isolated``).
+    """
+
+    def __init__(self, pending: _Pending, results: ResultsLog, engine: Engine,
+                 functions: JobFunctions, out_s: str,
+                 on_record: Callable[[dict], None] | None):
+        self.plan_done, self.ready, self.waiting = pending.plan_done, pending.ready, \
+            pending.waiting
+        self.results, self.engine, self.functions = results, engine, functions
+        self.out_s, self.on_record = out_s, on_record
+        self.ran = 0
+        self.in_flight: dict[Future, object] = {}
+        self.suspects: deque = deque()
+        self.isolated = False
+        self.submitted: set[str] = set()  # keys of jobs submitted (suspects' re-runs once)
+
+    def record(self, job, status: str, fields: dict) -> None:
+        """Append a job's record to the results file."""
         rec = {**job.describe(), "status": status, **fields, "finished_at": _now()}
-        results.append(rec)
-        ran += 1
-        if on_record is not None:
-            on_record(rec)
+        self.results.append(rec)
+        self.ran += 1
+        if self.on_record is not None:
+            self.on_record(rec)
 
-    def release(plan_key: str) -> None:
-        prec = plan_done[plan_key]
-        for v in reversed(waiting.pop(plan_key, [])):
+    def release(self, plan_key: str) -> None:
+        """A plan job finished: queue its validate jobs first, or record them at once as
+        failed (no plan) or errors (the plan job raised)."""
+        prec = self.plan_done[plan_key]
+        for v in reversed(self.waiting.pop(plan_key, [])):
             if prec.get("status") == "ok" and prec.get("outcome") == "planned":
-                ready.appendleft(v)
+                self.ready.appendleft(v)
             elif prec.get("status") == "ok":
-                record(v, "ok", {"outcome": "failed", "cause": "no_plan",
-                                 "why": f"no plan: {prec.get('why', '')}",
-                                 "simulated_s": 0.0, "simulated_s_per_rung": None})
+                self.record(v, "ok", {"outcome": "failed", "cause": "no_plan",
+                                      "why": f"no plan: {prec.get('why', '')}",
+                                      "simulated_s": 0.0, "simulated_s_per_rung": None})
             else:
-                record(v, "error", {"error": f"its plan job {plan_key} failed: "
-                                             f"{prec.get('error', '?')}"})
+                self.record(v, "error", {"error": f"its plan job {plan_key} failed: "
+                                                  f"{prec.get('error', '?')}"})
 
-    for key in list(waiting):
-        if key in plan_done:
-            release(key)
-
-    in_flight: dict[Future, object] = {}
-    suspects: deque = deque()
-    isolated = False
-    submitted: set[str] = set()  # keys of jobs submitted (re-runs of suspects count once)
-
-    def submit(job) -> None:
-        args = (functions.plan, job, out_s) if isinstance(job, PlanJob) else \
-            (functions.validate, job, plan_done[job.plan.key], out_s)
+    def submit(self, job) -> None:
+        """Send a job to the engine (restarting a pool that broke since the last wait)."""
+        args = (self.functions.plan, job, self.out_s) if isinstance(job, PlanJob) else \
+            (self.functions.validate, job, self.plan_done[job.plan.key], self.out_s)
         try:
-            fut = engine.submit(timed_call, *args)
+            fut = self.engine.submit(timed_call, *args)
         except BrokenProcessPool:  # the pool broke after the last wait: start a new one
-            engine.restart()
-            fut = engine.submit(timed_call, *args)
-        in_flight[fut] = job
-        submitted.add(job.key)
+            self.engine.restart()
+            fut = self.engine.submit(timed_call, *args)
+        self.in_flight[fut] = job
+        self.submitted.add(job.key)
 
-    def finish(job, status: str, fields: dict) -> None:
-        record(job, status, fields)
+    def finish(self, job, status: str, fields: dict) -> None:
+        """Record a job that ended; a plan job's end releases its validate jobs."""
+        self.record(job, status, fields)
         if isinstance(job, PlanJob):
-            plan_done[job.key] = results.latest[job.key]
-            release(job.key)
+            self.plan_done[job.key] = self.results.latest[job.key]
+            self.release(job.key)
 
-    try:
-        while True:
-            if isolated and not in_flight:
-                isolated = False
-            if suspects or isolated:
-                if not in_flight:
-                    submit(suspects.popleft())
-                    isolated = True
-            else:
-                while len(in_flight) < engine.slots and ready and \
-                        (max_jobs is None or len(submitted) < max_jobs):
-                    submit(ready.popleft())
-            if not in_flight:
-                break
-            done, _ = wait(list(in_flight), return_when=FIRST_COMPLETED)
-            broken = False
-            for fut in done:
-                job = in_flight.pop(fut)
-                try:
-                    outcome = fut.result()
-                except BrokenProcessPool:
-                    broken = True
-                    if isolated:
-                        finish(job, "error", {"error": "BrokenProcessPool: the worker process "
-                                              "died while running this job alone"})
-                    else:
-                        suspects.append(job)
-                    continue
-                except Exception as exc:  # a job error: record it, go on
-                    msg, tb = _error_text(exc)
-                    log.warning("%s failed: %s", job.key, msg)
-                    finish(job, "error", {"error": msg, "traceback": tb})
-                    continue
-                finish(job, "ok", outcome)
-            if broken:
-                for fut in list(in_flight):  # the rest of the pool is gone too
-                    suspects.append(in_flight.pop(fut))
-                log.warning("a worker died; re-running %d job(s) in flight one at a time",
-                            len(suspects))
-                engine.restart()
-    except BaseException:
-        for fut in in_flight:
-            fut.cancel()
-        raise
+    def fill(self, max_jobs: int | None) -> None:
+        """Submit what may run now: one suspect alone, or ready jobs up to the slots."""
+        if self.isolated and not self.in_flight:
+            self.isolated = False
+        if self.suspects or self.isolated:
+            if not self.in_flight:
+                self.submit(self.suspects.popleft())
+                self.isolated = True
+        else:
+            while len(self.in_flight) < self.engine.slots and self.ready and \
+                    (max_jobs is None or len(self.submitted) < max_jobs):
+                self.submit(self.ready.popleft())
 
-    records = [results.latest[j.key] for j in [*plans, *validations] if j.key in results.latest]
-    return BatchRun(records, skipped, ran, time.perf_counter() - t_start, engine.description,
-                    [r for r in records if r.get("status") == "error"])
+    def collect(self, done: set[Future]) -> bool:
+        """Record the jobs of finished futures; True if the pool broke under one."""
+        broken = False
+        for fut in done:
+            job = self.in_flight.pop(fut)
+            try:
+                outcome = fut.result()
+            except BrokenProcessPool:
+                broken = True
+                if self.isolated:
+                    self.finish(job, "error", {"error": "BrokenProcessPool: the worker "
+                                               "process died while running this job alone"})
+                else:
+                    self.suspects.append(job)
+                continue
+            except Exception as exc:  # a job error: record it, go on
+                msg, tb = _error_text(exc)
+                log.warning("%s failed: %s", job.key, msg)
+                self.finish(job, "error", {"error": msg, "traceback": tb})
+                continue
+            self.finish(job, "ok", outcome)
+        return broken
+
+    def run(self, max_jobs: int | None) -> None:
+        """Submit and collect until nothing is left in flight; on any exception (Ctrl-C
+        included) cancel what has not started."""
+        try:
+            while True:
+                self.fill(max_jobs)
+                if not self.in_flight:
+                    break
+                done, _ = wait(list(self.in_flight), return_when=FIRST_COMPLETED)
+                if self.collect(done):
+                    for fut in list(self.in_flight):  # the rest of the pool is gone too
+                        self.suspects.append(self.in_flight.pop(fut))
+                    log.warning("a worker died; re-running %d job(s) in flight one at a "
+                                "time", len(self.suspects))
+                    self.engine.restart()
+        except BaseException:
+            for fut in self.in_flight:
+                fut.cancel()
+            raise

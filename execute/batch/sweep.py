@@ -161,6 +161,27 @@ def parse_sweep_yaml(text: str, source: str = "<string>",
             problems.add(root, f"field '{key}' is missing")
     problems.raise_if_any()
 
+    mode, samples, seed = _mode(root, top, problems)
+    base = _base_ladder(top["base"][1], base_dir, problems)
+    params_node = top["parameters"][1]
+    params = mapping_items(params_node, "field 'parameters'", problems) or {}
+    axes = _parameter_axes(params_node, params, mode, problems)
+    problems.raise_if_any()
+    assert base is not None
+
+    if mode == "grid":
+        combos = _grid_combos(axes, params_node, problems)
+    else:
+        combos = _random_combos(axes, samples or 0, seed)
+    cells = _cells(base, combos, params, root, problems)
+    problems.raise_if_any()
+    return cells
+
+
+def _mode(root: yaml.Node, top: dict, problems: YamlProblems
+          ) -> tuple[str, int | None, int | None]:
+    """The sweep's mode (``grid`` unless given) and, for ``random``, its sample count and
+    seed (0 unless given); a grid given a count or seed is a problem."""
     mode = "grid"
     if "mode" in top:
         mode = _value(top["mode"][1])
@@ -179,25 +200,33 @@ def parse_sweep_yaml(text: str, source: str = "<string>",
         for key in ("samples", "seed"):
             if key in top:
                 problems.add(top[key][0], f"field '{key}' is only used with mode: random")
+    return mode, samples, seed
 
-    base_node = top["base"][1]
+
+def _base_ladder(base_node: yaml.Node, base_dir: str | os.PathLike[str],
+                 problems: YamlProblems) -> LadderSpec | None:
+    """The ladder the sweep varies: a bundled name, or a spec file relative to
+    ``base_dir``; None (and a problem) if it cannot be loaded."""
     base_name = _value(base_node)
-    base: LadderSpec | None = None
     if not isinstance(base_name, str):
         problems.add(base_node, f"field 'base' = {base_name!r}: a bundled ladder name or a "
                      "spec file path")
-    else:
-        arg = base_name
-        if ("/" in arg or arg.endswith((".yaml", ".yml"))) and not os.path.isabs(arg):
-            arg = str(Path(base_dir) / arg)
-        try:
-            base = load_ladder(arg)
-        except LadderSpecError as exc:
-            problems.add(base_node, f"field 'base': {exc}")
+        return None
+    arg = base_name
+    if ("/" in arg or arg.endswith((".yaml", ".yml"))) and not os.path.isabs(arg):
+        arg = str(Path(base_dir) / arg)
+    try:
+        return load_ladder(arg)
+    except LadderSpecError as exc:
+        problems.add(base_node, f"field 'base': {exc}")
+        return None
 
-    params = mapping_items(top["parameters"][1], "field 'parameters'", problems) or {}
-    if not params and isinstance(top["parameters"][1], yaml.MappingNode):
-        problems.add(top["parameters"][1], "field 'parameters' is empty; sweep at least one "
+
+def _parameter_axes(params_node: yaml.Node, params: dict, mode: str,
+                    problems: YamlProblems) -> dict[str, tuple[str, Any]]:
+    """Each swept field's axis (`_axis`), in the file's order; only `SWEEP_FIELDS`."""
+    if not params and isinstance(params_node, yaml.MappingNode):
+        problems.add(params_node, "field 'parameters' is empty; sweep at least one "
                      f"of {', '.join(SWEEP_FIELDS)}")
     axes: dict[str, tuple[str, Any]] = {}
     for field, (knode, vnode) in params.items():
@@ -208,34 +237,48 @@ def parse_sweep_yaml(text: str, source: str = "<string>",
         axis = _axis(field, vnode, mode, problems)
         if axis is not None:
             axes[field] = axis
-    problems.raise_if_any()
-    assert base is not None
+    return axes
 
+
+def _grid_combos(axes: dict[str, tuple[str, Any]], params_node: yaml.Node,
+                 problems: YamlProblems) -> list[dict[str, Any]]:
+    """Every combination of the axes' values, row-major in the file's parameter order
+    (at most `MAX_CELLS`)."""
     names = list(axes)
-    combos: list[dict[str, Any]] = []
-    if mode == "grid":
-        total = int(np.prod([len(axes[f][1]) for f in names]))
-        if total > MAX_CELLS:
-            problems.add(top["parameters"][1], f"the grid has {total} cells; at most "
-                         f"{MAX_CELLS} are allowed")
-            problems.raise_if_any()
-        for values in itertools.product(*(axes[f][1] for f in names)):
-            combos.append(dict(zip(names, values, strict=True)))
-    else:
-        rng = np.random.default_rng(seed)
-        for _ in range(samples or 0):
-            combo: dict[str, Any] = {}
-            for f in names:
-                kind, spec = axes[f]
-                if kind == "choice":
-                    v = spec[int(rng.integers(len(spec)))]
-                else:
-                    v = float(rng.uniform(*spec))
-                    if FIELD_RULES[f].kind == "int":
-                        v = int(round(v))
-                combo[f] = v
-            combos.append(combo)
+    total = int(np.prod([len(axes[f][1]) for f in names]))
+    if total > MAX_CELLS:
+        problems.add(params_node, f"the grid has {total} cells; at most "
+                     f"{MAX_CELLS} are allowed")
+        problems.raise_if_any()
+    return [dict(zip(names, values, strict=True))
+            for values in itertools.product(*(axes[f][1] for f in names))]
 
+
+def _random_combos(axes: dict[str, tuple[str, Any]], samples: int,
+                   seed: int | None) -> list[dict[str, Any]]:
+    """``samples`` combinations drawn with ``seed``: a listed value uniformly, a range
+    from U(min, max) (rounded for an integer field)."""
+    rng = np.random.default_rng(seed)
+    combos: list[dict[str, Any]] = []
+    for _ in range(samples):
+        combo: dict[str, Any] = {}
+        for f in axes:
+            kind, spec = axes[f]
+            if kind == "choice":
+                v = spec[int(rng.integers(len(spec)))]
+            else:
+                v = float(rng.uniform(*spec))
+                if FIELD_RULES[f].kind == "int":
+                    v = int(round(v))
+            combo[f] = v
+        combos.append(combo)
+    return combos
+
+
+def _cells(base: LadderSpec, combos: list[dict[str, Any]], params: dict, root: yaml.Node,
+           problems: YamlProblems) -> list[SweepCell]:
+    """The base ladder with each combination, named ``<base>.c<index>``; a combination
+    that breaks a cross-field rule is a problem at its first parameter."""
     width = max(3, len(str(len(combos) - 1)))
     cells = []
     for i, combo in enumerate(combos):
@@ -248,7 +291,6 @@ def parse_sweep_yaml(text: str, source: str = "<string>",
                          f"{exc}")
             continue
         cells.append(SweepCell(name, spec, combo))
-    problems.raise_if_any()
     return cells
 
 
