@@ -240,114 +240,141 @@ def _send_gains(gains, instance: str) -> None:
 
 
 def _play(args, traj, player, auto, motion=None) -> int:
+    """Play to the daemon once it runs, is homed and the robot stands at the start line;
+    returns the exit code. The channels are closed and the terminal restored on exit."""
     from daemon.channels import open_channel
-    from daemon.loop import sleep_until_ns
-    from daemon.structs import REF_DTYPE, new_sample
     from robot.limits import joint_limits
-    from robot.motors import DEFAULT_BATTERY_V, motor_table
 
     limits = joint_limits(args.robot)
 
     ref = open_channel("ref", args.instance)
     state = open_channel("state", args.instance)
     keys = None
-    flags = {"stop": False, "toggles": 0}
     try:
         s = _wait_for_daemon(state, args.instance)
         if not args.init:
             _check_start(traj, args.line, np.asarray(s["pos"]), args.line_tolerance)
         if motion is not None:
             _send_gains(motion.pwm_gains, args.instance)
-
-        def on_stop(signum, frame):
-            flags["stop"] = True
-
-        def on_usr1(signum, frame):
-            flags["toggles"] += 1
-
-        signal.signal(signal.SIGINT, on_stop)
-        signal.signal(signal.SIGTERM, on_stop)
-        if args.pause:
-            signal.signal(signal.SIGUSR1, on_usr1)
-            if sys.stdin.isatty():
-                keys = _Keys()
-        sample = new_sample(REF_DTYPE)
-        sample["playing"] = 1
-        motors = motor_table()
-        n = player.num_lines
+        signals = _Signals(args.pause)
+        if args.pause and sys.stdin.isatty():
+            keys = _Keys()
         if not args.quiet:
             modes = "sidecar arm modes" if auto else "no sidecar arm modes"
-            print(f"play-trajectory: {args.file}: {n} lines at {player.options.rate_hz} Hz, "
-                  f"{player.duration_s:.1f} s, {modes}" + ("; p pauses" if args.pause else ""),
-                  file=sys.stderr, flush=True)
-        deadline = time.monotonic_ns()
-        next_show = 0.0
-        t0_s = time.monotonic()
-        tick = None
-        while True:
-            now_s = time.monotonic()
-            if keys is not None:
-                flags["toggles"] += keys.presses()
-            if flags["stop"]:
-                break
-            # The state only matters for go-to-init's start pose and the feed-forward's
-            # battery voltage.
-            latest = state.read_latest() if (motion is not None or not player.started
-                                             or player.has_feedforward) else None
-            # go-to-init starts from the measured pose, within the limits (the daemon
-            # rejects a reference beyond them; an encoder may read a hair past one)
-            pos = np.clip(latest["pos"], limits.lower_rad, limits.upper_rad) \
-                if not player.started else None
-            if player.started:
-                while flags["toggles"]:
-                    flags["toggles"] -= 1
-                    player.toggle_pause(now_s)
-            tick = player.step(now_s, pos) if motion is None else motion.step(now_s, latest)
-            if motion is not None and motion.stop is not None:
-                sample["playing"] = 0  # hold: every verified grip kept, nothing loaded
-                ref.write(sample)
-                print(f"\nplay-trajectory: the motion layer stopped at line "
-                      f"{motion.stop.line} and holds: {motion.stop.reason}",
-                      file=sys.stderr, flush=True)
-                return 1
-            sample["ref"] = tick.ref_rad
-            sample["mode"] = tick.mode
-            sample["comply"] = tick.comply
-            if player.has_feedforward:
-                volts = float(latest["power"]["V"])
-                sample["pwm_command"] = player.feedforward_duty(
-                    tick, volts if volts > 0 else DEFAULT_BATTERY_V, motors)
-            if tick.finished:
-                sample["playing"] = 0
-            ref.write(sample)
-            if not args.quiet and (now_s >= next_show or tick.finished):
-                next_show = now_s + 0.25
-                phase = "done" if tick.finished else "paused" if tick.paused else \
-                    "init" if tick.going_to_init else "play"
-                t = now_s - t0_s
-                print(f"\rline {tick.line_number:5d}/{n}  t {t:6.2f} s  "
-                      f"left {tick.arm_modes['left']:8s}  right {tick.arm_modes['right']:8s}"
-                      f"  {phase:6s}", end="", file=sys.stderr, flush=True)
-            if tick.finished:
-                if not args.quiet:
-                    print(file=sys.stderr)
-                return 0
-            deadline += TICK_NS
-            now = time.monotonic_ns()
-            if now >= deadline:
-                deadline += ((now - deadline) // TICK_NS + 1) * TICK_NS
-            sleep_until_ns(deadline)
-        sample["playing"] = 0  # stop and hold: the last reference stays
-        ref.write(sample)
-        where = f"line {tick.line_number}" if tick is not None else "the start"
-        print(f"\nplay-trajectory: stopped at {where}; the robot holds the last reference",
-              file=sys.stderr, flush=True)
-        return 130
+            print(f"play-trajectory: {args.file}: {player.num_lines} lines at "
+                  f"{player.options.rate_hz} Hz, {player.duration_s:.1f} s, {modes}"
+                  + ("; p pauses" if args.pause else ""), file=sys.stderr, flush=True)
+        return _stream(args, player, motion, ref, state, limits, signals, keys)
     finally:
         if keys is not None:
             keys.close()
         ref.close()
         state.close()
+
+
+class _Signals:
+    """What the signals asked of the playback loop: stop (SIGINT, SIGTERM) and, with
+    ``-p``, pause toggles (SIGUSR1; the ``p`` key adds its presses)."""
+
+    def __init__(self, pause: bool) -> None:
+        self.stop = False
+        self.toggles = 0
+        signal.signal(signal.SIGINT, self._on_stop)
+        signal.signal(signal.SIGTERM, self._on_stop)
+        if pause:
+            signal.signal(signal.SIGUSR1, self._on_usr1)
+
+    def _on_stop(self, signum, frame) -> None:
+        self.stop = True
+
+    def _on_usr1(self, signum, frame) -> None:
+        self.toggles += 1
+
+
+def _stream(args, player, motion, ref, state, limits, signals: _Signals, keys) -> int:
+    """One ``ref`` sample per `TICK_NS` on absolute deadlines, until the file ends (0),
+    the motion layer stops and holds (1) or a signal stops it (130, holding)."""
+    from daemon.loop import sleep_until_ns
+    from daemon.structs import REF_DTYPE, new_sample
+    from robot.motors import DEFAULT_BATTERY_V, motor_table
+
+    sample = new_sample(REF_DTYPE)
+    sample["playing"] = 1
+    motors = motor_table()
+    deadline = time.monotonic_ns()
+    next_show = 0.0
+    t0_s = time.monotonic()
+    tick = None
+    while True:
+        now_s = time.monotonic()
+        if keys is not None:
+            signals.toggles += keys.presses()
+        if signals.stop:
+            break
+        # The state only matters for go-to-init's start pose and the feed-forward's
+        # battery voltage.
+        latest = state.read_latest() if (motion is not None or not player.started
+                                         or player.has_feedforward) else None
+        # go-to-init starts from the measured pose, within the limits (the daemon
+        # rejects a reference beyond them; an encoder may read a hair past one)
+        pos = np.clip(latest["pos"], limits.lower_rad, limits.upper_rad) \
+            if not player.started else None
+        if player.started:
+            while signals.toggles:
+                signals.toggles -= 1
+                player.toggle_pause(now_s)
+        tick = player.step(now_s, pos) if motion is None else motion.step(now_s, latest)
+        if motion is not None and motion.stop is not None:
+            sample["playing"] = 0  # hold: every verified grip kept, nothing loaded
+            ref.write(sample)
+            print(f"\nplay-trajectory: the motion layer stopped at line "
+                  f"{motion.stop.line} and holds: {motion.stop.reason}",
+                  file=sys.stderr, flush=True)
+            return 1
+        _fill_ref_sample(sample, tick, player, latest, motors, DEFAULT_BATTERY_V)
+        ref.write(sample)
+        if not args.quiet and (now_s >= next_show or tick.finished):
+            next_show = now_s + 0.25
+            _show_progress(tick, now_s - t0_s, player.num_lines)
+        if tick.finished:
+            if not args.quiet:
+                print(file=sys.stderr)
+            return 0
+        deadline += TICK_NS
+        now = time.monotonic_ns()
+        if now >= deadline:
+            deadline += ((now - deadline) // TICK_NS + 1) * TICK_NS
+        sleep_until_ns(deadline)
+    sample["playing"] = 0  # stop and hold: the last reference stays
+    ref.write(sample)
+    where = f"line {tick.line_number}" if tick is not None else "the start"
+    print(f"\nplay-trajectory: stopped at {where}; the robot holds the last reference",
+          file=sys.stderr, flush=True)
+    return 130
+
+
+def _fill_ref_sample(sample, tick, player, latest, motors, default_battery_v: float) -> None:
+    """A tick's references, modes and compliance into the ``ref`` sample, with the
+    feed-forward as PWM duty at the battery voltage the daemon reports (the default
+    [V] while it reports none)."""
+    sample["ref"] = tick.ref_rad
+    sample["mode"] = tick.mode
+    sample["comply"] = tick.comply
+    if player.has_feedforward:
+        volts = float(latest["power"]["V"])
+        sample["pwm_command"] = player.feedforward_duty(
+            tick, volts if volts > 0 else default_battery_v, motors)
+    if tick.finished:
+        sample["playing"] = 0
+
+
+def _show_progress(tick, t_s: float, n: int) -> None:
+    """The progress line: line, time since the start [s], the arms' modes, the phase."""
+    phase = "done" if tick.finished else "paused" if tick.paused else \
+        "init" if tick.going_to_init else "play"
+    print(f"\rline {tick.line_number:5d}/{n}  t {t_s:6.2f} s  "
+          f"left {tick.arm_modes['left']:8s}  right {tick.arm_modes['right']:8s}"
+          f"  {phase:6s}", end="", file=sys.stderr, flush=True)
 
 
 def main(argv: list[str] | None = None) -> int:
