@@ -8,6 +8,8 @@ import sys
 from pathlib import Path
 from types import SimpleNamespace
 
+import pytest
+
 sys.path.insert(0, str(Path(__file__).parent / "fixtures"))
 
 from make_fixture import cached_reach_fixture  # noqa: E402
@@ -16,6 +18,7 @@ from execute.validate.cli import CAUSE_CHARS, main, verdict_lines  # noqa: E402
 from execute.validate.metrics import rungs_climbed  # noqa: E402
 from execute.validate.verdict import Failure, Verdict  # noqa: E402
 from robot.plan_sidecar import HoldRecord, Segment  # noqa: E402
+from robot.vocabulary import FailureCause  # noqa: E402
 
 
 def _segment(first: int, last: int, rung: int, feet: dict[str, str]) -> Segment:
@@ -48,13 +51,22 @@ def _fake(verdict: Verdict, rungs: int = 0):
 def test_a_failure_prints_cause_time_line_and_what_to_try():
     why = ("board JMC6 tripped at t = 86.68 s: LKN held |τ| ≥ 59.4 N·m (99% of its 60 N·m "
            "limit) for 0.50 s (peak 59.9 N·m)" + "; more" * 500)
-    lines = verdict_lines(*_fake(Verdict(False, Failure("board_trip", 86.68, 250, why, {}), {})))
+    failure = Failure(FailureCause.BOARD_TRIP, 86.68, 250, why, {})
+    lines = verdict_lines(*_fake(Verdict(False, failure, {})))
     assert lines[0] == "verdict: failed (board_trip)"
     assert lines[1].startswith("cause:   board JMC6 tripped") and lines[1].endswith("…")
     assert lines[2] == "when:    t = 86.68 s, line 250 of 300 (climbRung@rung1, limb phase)"
     assert lines[3].startswith("next:    ") and "--max-torque-ratio" in lines[3]
     assert "climbed 0 of 9 rungs" in lines[4] and "49° per grasp" in lines[4]
     assert len(lines) == 5 and all(len(line) <= CAUSE_CHARS + 20 for line in lines[:3])
+
+
+def test_a_failure_cause_is_the_vocabulary_and_its_json_the_plain_string():
+    failure = Failure("grasp_lost", 1.0, 2, "why")
+    assert failure.cause is FailureCause.GRASP_LOST
+    assert json.dumps({"cause": failure.cause.value}) == '{"cause": "grasp_lost"}'
+    with pytest.raises(ValueError, match="slipped"):
+        Failure("slipped", 1.0, 2, "why")
 
 
 def test_a_climb_prints_holds_and_time(tmp_path_factory, tmp_path, capsys):

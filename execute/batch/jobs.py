@@ -36,9 +36,13 @@ from execute.batch.perturb import Draw, PerturbSpec, draw
 from ladders.spec import LadderSpec
 from planner.time_limit import HARD_LIMIT_GRACE_S, TimeLimitExceeded, hard_time_limit
 from robot.constants import DAEMON_RATE_HZ
+from robot.vocabulary import FailureCause
 
 __all__ = ["DEFAULT_JOB_FUNCTIONS", "HARD_LIMIT_GRACE_S", "JobFunctions", "PlanJob",
            "ValidateJob", "expand_jobs", "plan_job", "validate_job"]
+
+#: The start of a plan job's outcome when it found no plan.
+_NO_PLAN = {"outcome": "no_plan", "cause": FailureCause.NO_PLAN.value}
 
 
 def _fingerprint(obj: dict) -> str:
@@ -210,10 +214,10 @@ def plan_job(job: PlanJob, out_dir: str) -> dict:
             result = planner.plan(top_rung=top)
     except PlanningFailed as exc:
         where = f"{exc.step.primitive.name} at rung {exc.step.rung}"
-        return {"outcome": "no_plan", "cause": "no_plan", "plan_s": time.perf_counter() - t0,
+        return {**_NO_PLAN, "plan_s": time.perf_counter() - t0,
                 "top_rung": top, "where": where, "why": f"{where}: {exc.reason}"}
     except TimeLimitExceeded:
-        return {"outcome": "no_plan", "cause": "no_plan", "plan_s": time.perf_counter() - t0,
+        return {**_NO_PLAN, "plan_s": time.perf_counter() - t0,
                 "top_rung": top, "where": "time limit",
                 "why": f"time limit of {job.time_limit_s:g} s reached"}
     search_s = time.perf_counter() - t0
@@ -223,7 +227,7 @@ def plan_job(job: PlanJob, out_dir: str) -> dict:
         written = write_plan(result, planner, out, job.rate_hz,
                              {"search_s": result.total_s, "setup_s": search_s - result.total_s})
     except TimingError as exc:
-        return {"outcome": "no_plan", "cause": "no_plan", "plan_s": time.perf_counter() - t0,
+        return {**_NO_PLAN, "plan_s": time.perf_counter() - t0,
                 "top_rung": top, "where": "timing", "why": f"timing: {exc}"}
     return {"outcome": "planned", "traj": job.traj_name, "plan_s": time.perf_counter() - t0,
             "search_s": result.total_s, "motion_s": written.timed.duration_s,

@@ -31,6 +31,7 @@ from pathlib import Path
 from execute.batch.engine import Engine
 from execute.batch.jobs import DEFAULT_JOB_FUNCTIONS, JobFunctions, PlanJob, ValidateJob
 from execute.batch.results import ResultsLog
+from robot.vocabulary import FailureCause
 
 __all__ = ["BatchRun", "RESULTS_FILE", "run_batch", "timed_call"]
 
@@ -197,7 +198,7 @@ class _Scheduler:
             if prec.get("status") == "ok" and prec.get("outcome") == "planned":
                 self.ready.appendleft(v)
             elif prec.get("status") == "ok":
-                self.record(v, "ok", {"outcome": "failed", "cause": "no_plan",
+                self.record(v, "ok", {"outcome": "failed", "cause": FailureCause.NO_PLAN.value,
                                       "why": f"no plan: {prec.get('why', '')}",
                                       "simulated_s": 0.0, "simulated_s_per_rung": None})
             else:

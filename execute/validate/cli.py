@@ -23,6 +23,7 @@ import sys
 from pathlib import Path
 
 from robot.errors import InputError, run_cli
+from robot.vocabulary import FailureCause
 
 __all__ = ["ladder_from_sidecar", "main", "result_json"]
 
@@ -86,20 +87,23 @@ def motion_summary(report: dict) -> str:
 
 #: What to try next, by failure cause (`verdict_lines`).
 NEXT_STEP = {
-    "board_trip": "the plan loads that joint to its limit: check-plan's torque ratio near that "
-                  "line; re-plan with a lower --max-torque-ratio or another --seed",
-    "fall": "the robot lost its balance: check-plan's stability margin near that line; "
-            "re-plan with a larger --foot-cop-margin or another --seed",
-    "hard_contact": "a body the plan keeps off the ladder hit it: check-plan's collision "
-                    "check near that line; re-plan with another --seed",
-    "grasp_not_latched": "the hand missed its rail: the closed loop corrects reaches up to "
-                         "--max-reach-correction with --grasp-retries; see --plots "
-                         "snapshots at that time",
-    "grasp_lost": "the grip let go under its load: re-plan with another --seed or "
-                  "--position-torque-share; the JSON's plan_vs_sim has the hold forces",
-    "final_stance": "the robot ended off its final holds: see --plots snapshots at the end",
-    "grasp_unverified": "the motion layer stopped (the JSON's motion section says why); "
-                        "--open-loop plays the file as the thesis did",
+    FailureCause.BOARD_TRIP: "the plan loads that joint to its limit: check-plan's torque "
+                             "ratio near that line; re-plan with a lower --max-torque-ratio "
+                             "or another --seed",
+    FailureCause.FALL: "the robot lost its balance: check-plan's stability margin near that "
+                       "line; re-plan with a larger --foot-cop-margin or another --seed",
+    FailureCause.HARD_CONTACT: "a body the plan keeps off the ladder hit it: check-plan's "
+                               "collision check near that line; re-plan with another --seed",
+    FailureCause.GRASP_NOT_LATCHED: "the hand missed its rail: the closed loop corrects "
+                                    "reaches up to --max-reach-correction with "
+                                    "--grasp-retries; see --plots snapshots at that time",
+    FailureCause.GRASP_LOST: "the grip let go under its load: re-plan with another --seed or "
+                             "--position-torque-share; the JSON's plan_vs_sim has the hold "
+                             "forces",
+    FailureCause.FINAL_STANCE: "the robot ended off its final holds: see --plots snapshots at "
+                               "the end",
+    FailureCause.GRASP_UNVERIFIED: "the motion layer stopped (the JSON's motion section says "
+                                   "why); --open-loop plays the file as the thesis did",
 }
 #: The longest cause line printed; the full text is the JSON's ``why``.
 CAUSE_CHARS = 160
@@ -159,7 +163,7 @@ def result_json(run, metrics, plan_path: str, comparison=None) -> dict:
     return {
         "plan": plan_path,
         "verdict": "climbed" if v.climbed else "failed",
-        "cause": None if f is None else f.cause,
+        "cause": None if f is None else f.cause.value,
         "time_s": run.simulated_s if f is None else f.time_s,
         "line": int(run.log.line_index[-1]) + 1 if f is None else f.line,
         "why": _why(run, metrics, comparison),

@@ -45,7 +45,7 @@ from ladders.geometry import LadderGeometry
 from ladders.spec import LadderSpec
 from robot.errors import InputError
 from robot.plan_sidecar import PlanSidecar
-from robot.vocabulary import ArmStrategy, HoldTargetKind, Limb
+from robot.vocabulary import ArmStrategy, FailureCause, HoldTargetKind, Limb
 
 __all__ = ["STRATEGIES", "SimulationLog", "SimulationOptions", "SimulationRun", "simulate"]
 
@@ -202,16 +202,7 @@ def simulate(trajectory_rad: np.ndarray, sidecar: PlanSidecar, ladder: LadderSpe
     """
     opt = options or SimulationOptions()
     n = len(trajectory_rad)
-    real_ladder = opt.placement.apply(ladder)
-    board = BoardModel(real_ladder, robot, opt.board)
-    T_err = LadderGeometry(real_ladder).T_world_ladder @ np.linalg.inv(
-        LadderGeometry(ladder).T_world_ladder)
-    first = sidecar.segments[0] if sidecar.segments else None
-    soles = None
-    if first is not None:
-        soles = {Limb(k).side.value: np.asarray(h.position_m) for k, h in first.holds.items()
-                 if Limb(k).is_foot and h.hold_target.kind is HoldTargetKind.FLOOR}
-    board.reset(trajectory_rad[0], soles or None)
+    board, T_err = _placed_board(trajectory_rad[0], sidecar, ladder, opt, robot)
     schedule, compliant = _schedule(opt.strategy, sidecar, n)
     rate = int(round(sidecar.rate_hz))
     player = TrajectoryPlayer(trajectory_rad, PlayerOptions(rate_hz=rate,
@@ -221,7 +212,6 @@ def simulate(trajectory_rad: np.ndarray, sidecar: PlanSidecar, ladder: LadderSpe
 
     monitor = VerdictMonitor(board, sidecar, T_err, opt.verdict)
     motion = None
-    state = new_sample(STATE_DTYPE)
     if opt.closed_loop:
         from execute.motion.layer import MotionLayer  # pinocchio: only when closing the loop
 
@@ -229,6 +219,45 @@ def simulate(trajectory_rad: np.ndarray, sidecar: PlanSidecar, ladder: LadderSpe
     gains = opt.gains or (default_drc_gains() if motion is None else motion.pwm_gains)
     rec = _Recorder(int(math.ceil((player.duration_s + opt.verdict.settle_s) / TICK_S)),
                     board.model.nq if opt.record_qpos else 0)
+    wall0 = time.perf_counter()
+    failure, line_index = _run_ticks(board, player, motion, controller, monitor, gains, rec,
+                                     opt, progress)
+    wall = time.perf_counter() - wall0
+    sim_log = rec.log()
+    verdict = _final_verdict(failure, motion, monitor, board.time_s, line_index)
+    return SimulationRun(verdict, sim_log, board, sidecar, opt, wall, board.time_s, rate,
+                         None if motion is None else motion.report())
+
+
+def _placed_board(q0_rad: np.ndarray, sidecar: PlanSidecar, ladder: LadderSpec,
+                  opt: SimulationOptions, robot: str) -> tuple[BoardModel, np.ndarray]:
+    """The board model on the ladder as placed (``opt.placement``), the robot at rest in
+    pose ``q0_rad`` with its soles where the plan's first segment puts them on the floor;
+    and T_err, the (4, 4) transform from the planned ladder to the placed one."""
+    real_ladder = opt.placement.apply(ladder)
+    board = BoardModel(real_ladder, robot, opt.board)
+    T_err = LadderGeometry(real_ladder).T_world_ladder @ np.linalg.inv(
+        LadderGeometry(ladder).T_world_ladder)
+    first = sidecar.segments[0] if sidecar.segments else None
+    soles = None
+    if first is not None:
+        soles = {Limb(k).side.value: np.asarray(h.position_m) for k, h in first.holds.items()
+                 if Limb(k).is_foot and h.hold_target.kind is HoldTargetKind.FLOOR}
+    board.reset(q0_rad, soles or None)
+    return board, T_err
+
+
+def _run_ticks(board: BoardModel, player: TrajectoryPlayer, motion, controller: JointController,
+               monitor: VerdictMonitor, gains: PwmGains, rec: _Recorder,
+               opt: SimulationOptions, progress: Callable[[float, float], None] | None
+               ) -> tuple[Failure | None, int]:
+    """The lock-step loop, one daemon tick per iteration, until the plan has settled, the
+    motion layer's hold after a stop is over, or (``opt.stop_on_failure``) a failure.
+
+    Returns:
+        The first failure the monitor saw (None if none) and the last tick's line index.
+    """
+    state = new_sample(STATE_DTYPE)
     d = board.data
     pelvis = monitor.pelvis
     sole_sites = [d.site("L_sole"), d.site("R_sole")]
@@ -236,7 +265,7 @@ def simulate(trajectory_rad: np.ndarray, sidecar: PlanSidecar, ladder: LadderSpe
     line_index = 0
     finished_at = stopped_at = None
     k = 0
-    wall0 = wall_report = time.perf_counter()
+    wall_report = time.perf_counter()
     expected_s = player.duration_s + opt.verdict.settle_s
     while True:
         now = k * TICK_S
@@ -272,16 +301,18 @@ def simulate(trajectory_rad: np.ndarray, sidecar: PlanSidecar, ladder: LadderSpe
             finished_at = board.time_s if finished_at is None else finished_at
             if board.time_s - finished_at >= opt.verdict.settle_s - 1e-9:
                 break
-    wall = time.perf_counter() - wall0
-    sim_log = rec.log()
+    return failure, line_index
+
+
+def _final_verdict(failure: Failure | None, motion, monitor: VerdictMonitor, time_s: float,
+                   line_index: int) -> Verdict:
+    """The run's verdict: its first failure; else a motion layer that stopped (a grasp it
+    could not verify); else the monitor's checks of the final stance."""
     if failure is None and motion is not None and motion.stop is not None:
         stop = motion.stop
-        failure = Failure("grasp_unverified", stop.time_s, stop.line,
+        failure = Failure(FailureCause.GRASP_UNVERIFIED, stop.time_s, stop.line,
                           f"the motion layer held the pose and stopped: {stop.reason}",
                           {"limb": stop.limb, "tries": stop.tries, **stop.details})
     if failure is not None:
-        verdict = Verdict(False, failure, {})
-    else:
-        verdict = monitor.final(board.time_s, line_index)
-    return SimulationRun(verdict, sim_log, board, sidecar, opt, wall, board.time_s, rate,
-                         None if motion is None else motion.report())
+        return Verdict(False, failure, {})
+    return monitor.final(time_s, line_index)

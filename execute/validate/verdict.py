@@ -31,7 +31,7 @@ import numpy as np
 
 from robot.constants import GRAVITY_M_S2
 from robot.plan_sidecar import HoldRecord, PlanSidecar
-from robot.vocabulary import HoldTargetKind, Limb
+from robot.vocabulary import FailureCause, HoldTargetKind, Limb
 
 __all__ = ["Failure", "Verdict", "VerdictConfig", "VerdictMonitor", "default_config"]
 
@@ -54,16 +54,18 @@ def default_config() -> VerdictConfig:
 
 @dataclass(frozen=True)
 class Failure:
-    """Why a run failed: ``cause`` (``fall``, ``hard_contact``, ``board_trip``,
-    ``grasp_not_latched``, ``grasp_lost``, ``final_stance``, ``grasp_unverified``: the
-    motion layer could not confirm a grasp and held the pose), when, on which line, and a
-    sentence with the physical quantities behind it."""
+    """Why a run failed: ``cause`` (a `robot.vocabulary.FailureCause`; ``grasp_unverified``:
+    the motion layer could not confirm a grasp and held the pose), when, on which line, and
+    a sentence with the physical quantities behind it."""
 
-    cause: str
+    cause: FailureCause
     time_s: float
     line: int
     why: str
     details: dict = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "cause", FailureCause(self.cause))  # a str: checked here
 
 
 @dataclass(frozen=True)
@@ -146,7 +148,7 @@ class VerdictMonitor:
             if ev.board in ("EJMC4", "EJMC5"):
                 extra = ("; it shares the board with that hand's fingers, so the hand "
                          "lost its grip")
-            return Failure("board_trip", time_s, line, str(ev) + extra,
+            return Failure(FailureCause.BOARD_TRIP, time_s, line, str(ev) + extra,
                            {"board": ev.board, "joint": ev.joint,
                             "torque_limit_nm": ev.torque_limit_nm,
                             "peak_torque_nm": ev.peak_torque_nm,
@@ -156,7 +158,7 @@ class VerdictMonitor:
         z = float(d.xpos[self.pelvis][2])
         tilt = math.acos(float(np.clip(d.xmat[self.pelvis][8], -1.0, 1.0)))
         if z < self.config.min_pelvis_height_m or tilt > self.config.max_tilt_rad:
-            return Failure("fall", time_s, line,
+            return Failure(FailureCause.FALL, time_s, line,
                            f"pelvis at {z:.2f} m (limit {self.config.min_pelvis_height_m} m), "
                            f"tilted {math.degrees(tilt):.0f}° (limit "
                            f"{math.degrees(self.config.max_tilt_rad):.0f}°)",
@@ -164,7 +166,7 @@ class VerdictMonitor:
         bad = self._hard_contact()
         if bad is not None:
             f, body, geom = bad
-            return Failure("hard_contact", time_s, line,
+            return Failure(FailureCause.HARD_CONTACT, time_s, line,
                            f"{body} hit {geom} with {f:.0f} N (limit "
                            f"{self.config.hard_contact_fraction * self.weight_n:.0f} N, "
                            f"{self.config.hard_contact_fraction:.0%} of the robot's weight)",
@@ -175,7 +177,7 @@ class VerdictMonitor:
                 limb = f"{g.hand}_hand"
                 hold = seg.holds.get(limb)
                 if hold is not None and hold.target == g.rail:
-                    return Failure("grasp_lost", time_s, line,
+                    return Failure(FailureCause.GRASP_LOST, time_s, line,
                                    f"{g.hand} hand let go of {g.rail}: {g.reason}",
                                    {"hand": g.hand, "rail": g.rail, "reason": g.reason})
         if self._segment_entry[0] != seg.first_line:
@@ -203,7 +205,7 @@ class VerdictMonitor:
                f"{dist * 100:.1f} cm from the rail axis (tolerance "
                f"{latch.config.position_tolerance_m * 100:.0f} cm), grip axis "
                f"{math.degrees(ang):.0f}° off, {miss * 100:.1f} cm from the planned grasp")
-        return Failure("grasp_not_latched", time_s, line, why,
+        return Failure(FailureCause.GRASP_NOT_LATCHED, time_s, line, why,
                        {"hand": Limb(limb).side, "rail": hold.target,
                         "palm_to_axis_m": dist, "grip_angle_deg": math.degrees(ang),
                         "palm_to_plan_m": miss, "hand_state": state})
@@ -258,6 +260,6 @@ class VerdictMonitor:
         bad = {k: v for k, v in status.items() if v != "ok"}
         if bad:
             why = "final stance not reached: " + "; ".join(f"{k} {v}" for k, v in bad.items())
-            return Verdict(False, Failure("final_stance", time_s, line_index + 1, why,
+            return Verdict(False, Failure(FailureCause.FINAL_STANCE, time_s, line_index + 1, why,
                                           {"holds": status}), status)
         return Verdict(True, None, status)
