@@ -253,41 +253,17 @@ class JointController:
         comply = _vector("comply_mask", comply_mask, bool)
         pos = _vector("pos_rad", pos_rad)
         vel = _vector("vel_rad_s", vel_rad_s)
-        command = gains.pwm_command_pct
-        if feedforward_pct is not None:
-            feedforward = _vector("feedforward_pct", feedforward_pct)
-            bad = np.abs(feedforward) > PWM_COMMAND_LIMIT_PCT
-            if bad.any():
-                names = ", ".join(JOINT_NAMES[i] for i in np.flatnonzero(bad))
-                raise ControlInputError(f"feedforward_pct of {names} is outside "
-                                        f"±{PWM_COMMAND_LIMIT_PCT:g} %")
-            command = np.clip(command + feedforward, -PWM_COMMAND_LIMIT_PCT,
-                              PWM_COMMAND_LIMIT_PCT)
+        command = _pwm_command(gains, feedforward_pct)
         if self._sent_rad is None:
             self.reset(pos)
-        lower, upper = self.limits.lower_rad, self.limits.upper_rad
-        rejected = ((ref_in < lower - REF_CLAMP_TOLERANCE_RAD)
-                    | (ref_in > upper + REF_CLAMP_TOLERANCE_RAD))
-        ref, ref_clamped = clamp_reference(np.where(rejected, self._ref_rad, ref_in), lower,
-                                           upper)
-        ref_clamped &= ~rejected
-        self._ref_rad = ref
-        prev = self._sent_rad
+        ref, rejected, ref_clamped = self._accept_reference(ref_in)
         state = self._state
 
         want_pwm = comply & self.compliance_capable
         leaving = (state == _COMPLIANT) & ~want_pwm
         returning = (state == _RETURNING) & ~want_pwm
-
-        sent = filter_reference(modes, ref, prev, pos, self.config.filter_length)
-        still_returning = returning  # the two steps below only on ticks that need them
-        if returning.any():
-            back_sent, back_done = rigid_return_step(prev, ref, self.config)
-            still_returning = returning & ~back_done
-            sent = np.where(still_returning, back_sent, sent)
-        if leaving.any():
-            sent = np.where(leaving, pos, sent)  # first tick out of PWM starts from the encoder
-        sent, sent_clamped = clamp_reference(sent, lower, upper)
+        sent, sent_clamped, still_returning = self._sent_reference(modes, ref, pos, leaving,
+                                                                   returning)
 
         duty, saturated = pwm_duty(sent, pos, vel, gains, command)
         duty = np.where(want_pwm, duty, 0.0)
@@ -312,3 +288,59 @@ class JointController:
             state=new_state.copy(),
             limit_rejected=rejected,
         )
+
+    def _accept_reference(self, ref_in: np.ndarray
+                          ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Step 1: a commanded reference beyond a joint limit by more than the tolerance
+        keeps that joint's previous accepted reference; one within it is clamped.
+
+        Returns:
+            The accepted reference [rad] (kept for the next tick), the rejected joints and
+            the clamped ones.
+        """
+        lower, upper = self.limits.lower_rad, self.limits.upper_rad
+        rejected = ((ref_in < lower - REF_CLAMP_TOLERANCE_RAD)
+                    | (ref_in > upper + REF_CLAMP_TOLERANCE_RAD))
+        ref, ref_clamped = clamp_reference(np.where(rejected, self._ref_rad, ref_in), lower,
+                                           upper)
+        ref_clamped &= ~rejected
+        self._ref_rad = ref
+        return ref, rejected, ref_clamped
+
+    def _sent_reference(self, modes: np.ndarray, ref: np.ndarray, pos: np.ndarray,
+                        leaving: np.ndarray, returning: np.ndarray
+                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Steps 2 to 4: the reference filtered by each joint's mode; a joint leaving PWM
+        starts from its encoder, a returning one takes a rigid-return step; then clamped
+        into the limits.
+
+        Returns:
+            The sent reference [rad], the joints it clamped and those still returning.
+        """
+        prev = self._sent_rad
+        sent = filter_reference(modes, ref, prev, pos, self.config.filter_length)
+        still_returning = returning  # the two steps below only on ticks that need them
+        if returning.any():
+            back_sent, back_done = rigid_return_step(prev, ref, self.config)
+            still_returning = returning & ~back_done
+            sent = np.where(still_returning, back_sent, sent)
+        if leaving.any():
+            sent = np.where(leaving, pos, sent)  # first tick out of PWM starts from the encoder
+        sent, sent_clamped = clamp_reference(sent, self.limits.lower_rad, self.limits.upper_rad)
+        return sent, sent_clamped, still_returning
+
+
+def _pwm_command(gains: PwmGains, feedforward_pct: np.ndarray | None) -> float | np.ndarray:
+    """The constant duty ``pwm_command_pct`` of the gains plus the player's feed-forward
+    [%], each within and the sum clipped to ``±PWM_COMMAND_LIMIT_PCT``."""
+    command = gains.pwm_command_pct
+    if feedforward_pct is not None:
+        feedforward = _vector("feedforward_pct", feedforward_pct)
+        bad = np.abs(feedforward) > PWM_COMMAND_LIMIT_PCT
+        if bad.any():
+            names = ", ".join(JOINT_NAMES[i] for i in np.flatnonzero(bad))
+            raise ControlInputError(f"feedforward_pct of {names} is outside "
+                                    f"±{PWM_COMMAND_LIMIT_PCT:g} %")
+        command = np.clip(command + feedforward, -PWM_COMMAND_LIMIT_PCT,
+                          PWM_COMMAND_LIMIT_PCT)
+    return command

@@ -266,75 +266,14 @@ def parse_joint_table(text: str, path: str = "<string>") -> JointTable:
     found: dict[str, tuple[int, JointParams]] = {}
     channels: dict[tuple[int, int, int], tuple[int, str]] = {}
     board_motors: dict[tuple[int, int], tuple[int, int]] = {}
-    inf = math.inf
     for lineno, tok in rows.rows:
         name = tok[0]
         if not rows.new_name(lineno, name, "joint", JOINT_NAMES, found):
             continue
-        v = {
-            "motNo": rows.ranged(lineno, tok, "motNo", 0, MAX_MOTORS - 1),
-            "refEnc": rows.ranged(lineno, tok, "refEnc", -(1 << 31), (1 << 31) - 1),
-            "drive": rows.ranged(lineno, tok, "drive", 1e-9, inf, integer=False),
-            "driven": rows.ranged(lineno, tok, "driven", 1e-9, inf, integer=False),
-            "harm": rows.ranged(lineno, tok, "harm", 1e-9, inf, integer=False),
-            "enc": rows.ranged(lineno, tok, "enc", 1, inf, integer=False),
-            "dir": rows.ranged(lineno, tok, "dir", 0, 0, allowed={-1, 1}),
-            "jmc": rows.ranged(lineno, tok, "jmc", 0, MAX_JMC),
-            "active": rows.ranged(lineno, tok, "active", 0, 0, allowed={0, 1}),
-            "can": rows.ranged(lineno, tok, "can", 0, NUM_CAN - 1),
-            "numMot": rows.ranged(lineno, tok, "numMot", 1, MAX_MOTORS),
-            "kp": rows.ranged(lineno, tok, "kp", 0, inf, integer=False),
-            "kd": rows.ranged(lineno, tok, "kd", 0, inf, integer=False),
-            "maxPWM": rows.ranged(lineno, tok, "maxPWM", 0, 100, integer=False),
-            "zeroed": rows.ranged(lineno, tok, "zeroed", 0, 0, allowed={0, 1}),
-        }
-        if any(x is None for x in v.values()):
+        v = _joint_values(rows, lineno, tok)
+        if v is None or not _claim_motor(rows, lineno, name, v, channels, board_motors):
             continue
-        if v["motNo"] >= v["numMot"]:
-            rows.error(lineno, "motNo", f"{v['motNo']} but the board has numMot={v['numMot']}")
-            continue
-        board = (v["can"], v["jmc"])
-        chan = board + (v["motNo"],)
-        if chan in channels:
-            first, other = channels[chan]
-            rows.error(
-                lineno,
-                "motNo",
-                f"can{board[0]} jmc {board[1]:#x} motor {v['motNo']} already used by "
-                f"{other} (line {first})",
-            )
-            continue
-        if board in board_motors and board_motors[board][1] != v["numMot"]:
-            rows.error(
-                lineno,
-                "numMot",
-                f"{v['numMot']} but line {board_motors[board][0]} gives this board "
-                f"numMot={board_motors[board][1]}",
-            )
-            continue
-        channels[chan] = (lineno, name)
-        board_motors.setdefault(board, (lineno, v["numMot"]))
-        found[name] = (
-            lineno,
-            JointParams(
-                name=name,
-                mot_no=v["motNo"],
-                ref_enc=v["refEnc"],
-                drive=v["drive"],
-                driven=v["driven"],
-                harm=v["harm"],
-                enc=v["enc"],
-                dir=v["dir"],
-                jmc=v["jmc"],
-                active=bool(v["active"]),
-                can=v["can"],
-                num_mot=v["numMot"],
-                kp=v["kp"],
-                kd=v["kd"],
-                max_pwm=v["maxPWM"],
-                zeroed=bool(v["zeroed"]),
-            ),
-        )
+        found[name] = (lineno, _joint_params(name, v))
     missing = [n for n in JOINT_NAMES if n not in found]
     if missing and not rows.problems:
         last = rows.rows[-1][0] if rows.rows else 0
@@ -343,6 +282,72 @@ def parse_joint_table(text: str, path: str = "<string>") -> JointTable:
         raise TableError(rows.problems)
     assert len(found) == NUM_JOINTS
     return JointTable(tuple(found[n][1] for n in JOINT_NAMES), path)
+
+
+def _joint_values(rows: _Rows, lineno: int, tok: list[str]) -> dict | None:
+    """A joint row's columns, each checked against its range; None if any is bad (each
+    problem is recorded in ``rows``)."""
+    inf = math.inf
+    v = {
+        "motNo": rows.ranged(lineno, tok, "motNo", 0, MAX_MOTORS - 1),
+        "refEnc": rows.ranged(lineno, tok, "refEnc", -(1 << 31), (1 << 31) - 1),
+        "drive": rows.ranged(lineno, tok, "drive", 1e-9, inf, integer=False),
+        "driven": rows.ranged(lineno, tok, "driven", 1e-9, inf, integer=False),
+        "harm": rows.ranged(lineno, tok, "harm", 1e-9, inf, integer=False),
+        "enc": rows.ranged(lineno, tok, "enc", 1, inf, integer=False),
+        "dir": rows.ranged(lineno, tok, "dir", 0, 0, allowed={-1, 1}),
+        "jmc": rows.ranged(lineno, tok, "jmc", 0, MAX_JMC),
+        "active": rows.ranged(lineno, tok, "active", 0, 0, allowed={0, 1}),
+        "can": rows.ranged(lineno, tok, "can", 0, NUM_CAN - 1),
+        "numMot": rows.ranged(lineno, tok, "numMot", 1, MAX_MOTORS),
+        "kp": rows.ranged(lineno, tok, "kp", 0, inf, integer=False),
+        "kd": rows.ranged(lineno, tok, "kd", 0, inf, integer=False),
+        "maxPWM": rows.ranged(lineno, tok, "maxPWM", 0, 100, integer=False),
+        "zeroed": rows.ranged(lineno, tok, "zeroed", 0, 0, allowed={0, 1}),
+    }
+    return None if any(x is None for x in v.values()) else v
+
+
+def _claim_motor(rows: _Rows, lineno: int, name: str, v: dict,
+                 channels: dict[tuple[int, int, int], tuple[int, str]],
+                 board_motors: dict[tuple[int, int], tuple[int, int]]) -> bool:
+    """Whether the joint's board motor (can, jmc, motNo) exists, is not another joint's,
+    and its board's motor count agrees with the board's earlier rows; if so, record it
+    in ``channels`` and ``board_motors``."""
+    if v["motNo"] >= v["numMot"]:
+        rows.error(lineno, "motNo", f"{v['motNo']} but the board has numMot={v['numMot']}")
+        return False
+    board = (v["can"], v["jmc"])
+    chan = board + (v["motNo"],)
+    if chan in channels:
+        first, other = channels[chan]
+        rows.error(
+            lineno,
+            "motNo",
+            f"can{board[0]} jmc {board[1]:#x} motor {v['motNo']} already used by "
+            f"{other} (line {first})",
+        )
+        return False
+    if board in board_motors and board_motors[board][1] != v["numMot"]:
+        rows.error(
+            lineno,
+            "numMot",
+            f"{v['numMot']} but line {board_motors[board][0]} gives this board "
+            f"numMot={board_motors[board][1]}",
+        )
+        return False
+    channels[chan] = (lineno, name)
+    board_motors.setdefault(board, (lineno, v["numMot"]))
+    return True
+
+
+def _joint_params(name: str, v: dict) -> JointParams:
+    """The checked columns of a joint row as its `JointParams`."""
+    return JointParams(
+        name=name, mot_no=v["motNo"], ref_enc=v["refEnc"], drive=v["drive"],
+        driven=v["driven"], harm=v["harm"], enc=v["enc"], dir=v["dir"], jmc=v["jmc"],
+        active=bool(v["active"]), can=v["can"], num_mot=v["numMot"], kp=v["kp"],
+        kd=v["kd"], max_pwm=v["maxPWM"], zeroed=bool(v["zeroed"]))
 
 
 def parse_sensor_table(text: str, path: str = "<string>") -> SensorTable:
