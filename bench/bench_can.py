@@ -1,4 +1,4 @@
-"""Benchmark: encode + decode of one whole 5 ms CAN cycle (`daemon.can.protocol.CyclePlan`).
+"""Benchmark: encode + decode of one whole 5 ms CAN cycle (`daemon.can.cycle_plan.CyclePlan`).
 
 Per cycle: the reference frames and requests of both buses are encoded from 40 joint
 references, and a full set of replies (encoder, FT, tilt/IMU, power) is decoded into
@@ -44,7 +44,7 @@ def _replies(plan, ref_rad: np.ndarray) -> dict[int, list]:
 
 def measure_cycle(n: int = 2000) -> tuple[np.ndarray, object]:
     """Per-cycle encode + decode times [ms] over ``n`` cycles, and the plan."""
-    from daemon.can.protocol import CyclePlan
+    from daemon.can.cycle_plan import CyclePlan
     from daemon.tables import load_joint_table, load_sensor_table
 
     plan = CyclePlan(load_joint_table(), load_sensor_table())

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from daemon.can import protocol as cp
+from daemon.can.cycle_plan import CyclePlan
 from daemon.can.emulator import BoardEmulator
 from daemon.tables import load_joint_table, load_sensor_table
 
@@ -23,7 +24,7 @@ def rig():
     channels = {0: f"emu{k}-can0", 1: f"emu{k}-can1"}
     buses = {b: can.Bus(interface="virtual", channel=c) for b, c in channels.items()}
     emu = BoardEmulator(joints, sensors, channels).start()
-    plan = cp.CyclePlan(joints, sensors)
+    plan = CyclePlan(joints, sensors)
     yield emu, buses, plan
     emu.stop()
     for bus in buses.values():

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from daemon.can import protocol as cp
+from daemon.can.cycle_plan import CyclePlan
 from daemon.structs import StatusFlag
 from daemon.tables import load_joint_table, load_sensor_table
 
@@ -98,7 +99,7 @@ def test_status_bits_to_flags():
 
 @pytest.fixture(scope="module")
 def plan():
-    return cp.CyclePlan(load_joint_table(), load_sensor_table())
+    return CyclePlan(load_joint_table(), load_sensor_table())
 
 
 def test_cycle_plan_budget_and_offsets(plan):

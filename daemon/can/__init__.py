@@ -1,6 +1,7 @@
 """The real robot's boards over CAN.
 
 - `protocol`: the Hubo frame protocol, one encoder/decoder per frame kind;
+- `cycle_plan`: the frames of one 5 ms cycle per bus, encoded and decoded vectorised;
 - `backend`: the daemon's ``can`` backend (python-can buses, one cycle per tick);
 - `emulator`: boards answering on virtual buses, for tests and benches.
 
@@ -13,8 +14,8 @@ _EXPORTS = {
     "BOARD_CMD_BYTES": "backend",
     "BoardEmulator": "emulator",
     "CanBackend": "backend",
-    "CyclePlan": "protocol",
-    "CycleReadings": "protocol",
+    "CyclePlan": "cycle_plan",
+    "CycleReadings": "cycle_plan",
     "EmulatorConfig": "emulator",
     "ProtocolError": "protocol",
     "parse_channels": "backend",

@@ -37,6 +37,7 @@ import can
 import numpy as np
 
 from daemon.can import protocol as cp
+from daemon.can.cycle_plan import CyclePlan
 from daemon.loop import BoardCommands, SensorFrame
 from daemon.structs import NUM_FT, NUM_IMU, BoardCommandType, StatusFlag
 from daemon.tables import JointTable, SensorTable, load_joint_table, load_sensor_table
@@ -110,7 +111,7 @@ class CanBackend:
                  buses: dict[int, can.BusABC] | None = None):
         self.joints = joints or load_joint_table()
         self.sensors = sensors or load_sensor_table()
-        self.plan = cp.CyclePlan(self.joints, self.sensors, period_s, bitrate)
+        self.plan = CyclePlan(self.joints, self.sensors, period_s, bitrate)
         self.period_s = period_s
         self.spread_fraction = spread_fraction
         self.slot_ns = max(int(slot_s * 1e9), 1)

@@ -1,8 +1,7 @@
 """The Hubo CAN frame protocol (DRC-Hubo, hubo-facts §4): pure encode and decode.
 
-No I/O here: functions turn numbers into `can.Message` objects and back, and `CyclePlan`
-lists (and encodes and decodes, vectorised) the frames of one 5 ms cycle per bus. All ids
-are standard 11-bit ids.
+No I/O here: functions turn numbers into `can.Message` objects and back, one encoder
+beside its decoder per frame kind. All ids are standard 11-bit ids.
 
 Given by hubo-facts §4:
 
@@ -38,8 +37,7 @@ Our interpretation where the facts are silent (ASSUMPTIONS, to check against a b
 - **Power reply** at 0x40 + 0x0E (the power board's number): uint16 LE V [0.01 V],
   int16 LE I [0.01 A]; P = V·I.
 
-Size: the protocol's table: every frame kind's encoder beside its decoder, and the
-vectorised cycle plan built from them.
+The frames of one whole cycle, planned per bus, are `daemon.can.cycle_plan`'s.
 """
 
 from __future__ import annotations
@@ -47,15 +45,12 @@ from __future__ import annotations
 import enum
 import math
 import struct
-from dataclasses import dataclass, field
 
 import can
 import numpy as np
 
-from daemon.structs import FT_NAMES, IMU_NAMES, NUM_FT, NUM_IMU, StatusFlag
-from daemon.tables import JointTable, SensorTable
+from daemon.structs import StatusFlag
 from robot.errors import HuboLadderError
-from robot.joints import NUM_JOINTS
 
 CMD_ID = 0x01
 SENSOR_REQ_ID = 0x02
@@ -82,8 +77,6 @@ SENSOR_POWER = 2
 MAX_COUNTS = (1 << 23) - 1  #: largest 24-bit sign-magnitude magnitude
 MAX_DUTY_TENTHS = 1000  #: 100 % in 0.1 % units
 DIR_BIT = 0x80
-
-FRAME_BITS = 108  #: HuboCan's budget per frame (8 data bytes, before bit stuffing)
 
 
 class ProtocolError(HuboLadderError):
@@ -124,7 +117,8 @@ def board_status_to_flags(status: int) -> StatusFlag:
     return flags
 
 
-def _msg(arbitration_id: int, data: bytes | bytearray) -> can.Message:
+def message(arbitration_id: int, data: bytes | bytearray) -> can.Message:
+    """A standard-id (11-bit) frame."""
     return can.Message(arbitration_id=arbitration_id, data=data, is_extended_id=False)
 
 
@@ -166,7 +160,7 @@ def encode_ref(jmc: int, counts: tuple[int, int], pair: int = 0) -> can.Message:
     """Position reference of one motor pair: id 0x10 + jmc (+ 0x100·pair), DLC 6."""
     words = to_sign_magnitude(np.asarray(counts, dtype=np.int64).reshape(2))
     data = words.astype("<u4").view(np.uint8).reshape(2, 4)[:, :3].tobytes()
-    return _msg(REF_BASE + jmc + PAIR_STRIDE * pair, data)
+    return message(REF_BASE + jmc + PAIR_STRIDE * pair, data)
 
 
 def decode_ref(msg: can.Message) -> tuple[int, int, tuple[int, int]]:
@@ -182,17 +176,17 @@ def decode_ref(msg: can.Message) -> tuple[int, int, tuple[int, int]]:
 
 def encode_enc_request(jmc: int, ch: int = 0) -> can.Message:
     """Encoder request ``[jmc, 0x03, ch]`` on id 0x01 (ch 0: every motor)."""
-    return _msg(CMD_ID, bytes([jmc, CMD_ENC_REQUEST, ch]))
+    return message(CMD_ID, bytes([jmc, CMD_ENC_REQUEST, ch]))
 
 
 def encode_status_request(jmc: int) -> can.Message:
     """Status request ``[jmc, 0x02]`` on id 0x01."""
-    return _msg(CMD_ID, bytes([jmc, CMD_STATUS_REQUEST]))
+    return message(CMD_ID, bytes([jmc, CMD_STATUS_REQUEST]))
 
 
 def encode_current_request(jmc: int) -> can.Message:
     """Current request ``[jmc, 0x04]`` on id 0x01."""
-    return _msg(CMD_ID, bytes([jmc, CMD_CURRENT_REQUEST]))
+    return message(CMD_ID, bytes([jmc, CMD_CURRENT_REQUEST]))
 
 
 def _duty_bytes(duty_pct: float) -> tuple[int, int]:
@@ -218,7 +212,7 @@ def encode_pwm(
     """
     h0, l0 = _duty_bytes(duty_pct[0])
     h1, l1 = _duty_bytes(duty_pct[1])
-    return _msg(CMD_ID, bytes([jmc, CMD_PWM, (pair << 4) | (mask & 0x03), h0, l0, h1, l1]))
+    return message(CMD_ID, bytes([jmc, CMD_PWM, (pair << 4) | (mask & 0x03), h0, l0, h1, l1]))
 
 
 def decode_command(msg: can.Message) -> tuple[int, int, dict]:
@@ -255,7 +249,7 @@ def encode_enc_reply(jmc: int, counts: list[int] | tuple[int, ...], pair: int = 
         data = struct.pack(f"<{len(counts)}i", *counts)
     except struct.error as exc:
         raise ProtocolError(f"encoder counts {counts} out of int32 range") from exc
-    return _msg(ENC_REPLY_BASE + jmc + PAIR_STRIDE * pair, data)
+    return message(ENC_REPLY_BASE + jmc + PAIR_STRIDE * pair, data)
 
 
 def decode_enc_reply(msg: can.Message) -> tuple[int, int, tuple[int, ...]]:
@@ -268,7 +262,7 @@ def decode_enc_reply(msg: can.Message) -> tuple[int, int, tuple[int, ...]]:
 
 def encode_status_reply(jmc: int, status: list[int] | tuple[int, ...]) -> can.Message:
     """Status reply: one `BoardStatus` byte per motor at id 0x150 + jmc."""
-    return _msg(STATUS_REPLY_BASE + jmc, bytes(status))
+    return message(STATUS_REPLY_BASE + jmc, bytes(status))
 
 
 def decode_status_reply(msg: can.Message) -> tuple[int, tuple[int, ...]]:
@@ -280,7 +274,7 @@ def decode_status_reply(msg: can.Message) -> tuple[int, tuple[int, ...]]:
 def encode_current_reply(jmc: int, current_a: list[float] | tuple[float, ...]) -> can.Message:
     """Current reply: int16 LE per motor [0.01 A] at id 0x1C0 + jmc (≤ 4 motors)."""
     raw = np.clip(np.rint(np.asarray(current_a, float) * 100.0), -32768, 32767)
-    return _msg(CURRENT_REPLY_BASE + jmc, raw.astype("<i2").tobytes())
+    return message(CURRENT_REPLY_BASE + jmc, raw.astype("<i2").tobytes())
 
 
 def decode_current_reply(msg: can.Message) -> tuple[int, tuple[float, ...]]:
@@ -294,7 +288,7 @@ def decode_current_reply(msg: can.Message) -> tuple[int, tuple[float, ...]]:
 
 def encode_sensor_request(board: int, kind: int) -> can.Message:
     """Sensor request ``[board, kind]`` on id 0x02 (0 FT, 1 tilt/IMU, 2 power)."""
-    return _msg(SENSOR_REQ_ID, bytes([board, kind]))
+    return message(SENSOR_REQ_ID, bytes([board, kind]))
 
 
 def decode_sensor_request(msg: can.Message) -> tuple[int, int]:
@@ -319,7 +313,7 @@ def _i16(values: tuple[float, ...], scale: float, what: str) -> bytes:
 def encode_ft_reply(board: int, mx: float, my: float, fz: float) -> can.Message:
     """FT reply at 0x40 + board: mx, my [N·m] in 0.01 N·m, fz [N] in 0.1 N."""
     data = _i16((mx, my), 100.0, "FT moment") + _i16((fz,), 10.0, "FT force")
-    return _msg(FT_REPLY_BASE + board, data)
+    return message(FT_REPLY_BASE + board, data)
 
 
 def decode_ft_reply(msg: can.Message) -> tuple[int, tuple[float, float, float]]:
@@ -331,12 +325,12 @@ def decode_ft_reply(msg: can.Message) -> tuple[int, tuple[float, float, float]]:
 
 def encode_tilt_reply(board: int, acc: tuple[float, float, float]) -> can.Message:
     """Tilt/IMU acceleration reply at 0x50 + board: ax, ay, az [m/s²] in 0.01 m/s²."""
-    return _msg(TILT_REPLY_BASE + board, _i16(acc, 100.0, "acceleration"))
+    return message(TILT_REPLY_BASE + board, _i16(acc, 100.0, "acceleration"))
 
 
 def encode_gyro_reply(board: int, rate: tuple[float, float, float]) -> can.Message:
     """IMU gyro reply at 0x58 + board: wx, wy, wz [rad/s] in 0.001 rad/s."""
-    return _msg(GYRO_REPLY_BASE + board, _i16(rate, 1000.0, "angular rate"))
+    return message(GYRO_REPLY_BASE + board, _i16(rate, 1000.0, "angular rate"))
 
 
 def decode_imu_reply(msg: can.Message) -> tuple[int, str, tuple[float, float, float]]:
@@ -353,7 +347,7 @@ def encode_power_reply(volts: float, amps: float) -> can.Message:
     v = int(round(volts * 100.0))
     if not 0 <= v <= 0xFFFF:
         raise ProtocolError(f"bus voltage {volts} V out of range")
-    return _msg(POWER_REPLY_ID, struct.pack("<H", v) + _i16((amps,), 100.0, "I"))
+    return message(POWER_REPLY_ID, struct.pack("<H", v) + _i16((amps,), 100.0, "I"))
 
 
 def decode_power_reply(msg: can.Message) -> tuple[float, float, float]:
@@ -364,325 +358,3 @@ def decode_power_reply(msg: can.Message) -> tuple[float, float, float]:
     volts = int.from_bytes(b[0:2], "little") / 100.0
     amps = int.from_bytes(b[2:4], "little", signed=True) / 100.0
     return volts, amps, volts * amps
-
-
-# ---------------------------------------------------------------- one 5 ms cycle
-
-
-@dataclass(frozen=True)
-class PlannedFrame:
-    """One frame of a cycle: sent by us (``tx``, with a send offset) or expected back."""
-
-    kind: str  # "ref", "enc_req", "ft_req", "tilt_req", "power_req", or "*_reply"
-    arbitration_id: int
-    board: int
-    tx: bool
-    offset_s: float = 0.0  # send time after the cycle start [s]; replies: 0
-
-
-@dataclass
-class BusPlan:
-    """The frames of one bus in one cycle and its load."""
-
-    can: int
-    frames: list[PlannedFrame] = field(default_factory=list)
-    period_s: float = 0.005
-    bitrate: float = 1e6
-
-    @property
-    def load(self) -> float:
-        """Bus load fraction: frames × 108 bits / (bitrate × period)."""
-        return len(self.frames) * FRAME_BITS / (self.bitrate * self.period_s)
-
-    @property
-    def tx_frames(self) -> list[PlannedFrame]:
-        return [f for f in self.frames if f.tx]
-
-
-@dataclass
-class CycleReadings:
-    """What one cycle's replies said (NaN / False where nothing came back)."""
-
-    enc: np.ndarray  # (40,) int64 counts
-    pos_rad: np.ndarray  # (40,)
-    got_enc: np.ndarray  # (40,) bool
-    status: np.ndarray  # (40,) uint32 StatusFlag bits (NO_REPLY where no reply)
-    current_a: np.ndarray  # (40,)
-    ft: np.ndarray  # (4, 3): mx [N·m], my [N·m], fz [N]
-    imu: np.ndarray  # (3, 6): ax ay az [m/s²], wx wy wz [rad/s]
-    power: np.ndarray  # (3,): V [V], I [A], P [W]
-    unknown: int = 0  # frames we did not expect
-
-
-class CyclePlan:
-    """The frames of one control cycle per bus, from the joint and sensor tables.
-
-    Per bus and cycle: one reference frame per motor pair, one encoder request per
-    board and its replies (one per pair), then the sensor requests and replies. The frames
-    we send are spread evenly over the period (HuboCan's scheme, no blocking polls).
-    Status and current are polled round robin in the spare time (`housekeeping`).
-
-    Args:
-        joints: the joint table.
-        sensors: the sensor table.
-        period_s: cycle period [s].
-        bitrate: bus bit rate [bit/s].
-    """
-
-    def __init__(
-        self,
-        joints: JointTable,
-        sensors: SensorTable,
-        period_s: float = 0.005,
-        bitrate: float = 1e6,
-    ):
-        self.joints = joints
-        self.sensors = sensors
-        self.period_s = period_s
-        self.buses: dict[int, BusPlan] = {}
-        boards = joints.boards()
-        # Reference frames: one row per (bus, board, pair); index array into the 40 joints.
-        self._ref_rows: list[tuple[int, int, int]] = []
-        ref_index = []
-        for (bus, jmc), chans in boards.items():
-            for pair in range((len(chans) + 1) // 2):
-                self._ref_rows.append((bus, jmc, pair))
-                two = list(chans[2 * pair : 2 * pair + 2]) + [-1]
-                ref_index.append(two[:2])
-        self._ref_index = np.array(ref_index, dtype=np.int64)  # (F, 2), −1 = none
-        self._ref_valid = self._ref_index >= 0
-        self._ref_ids = [REF_BASE + jmc + PAIR_STRIDE * pair for _, jmc, pair in self._ref_rows]
-        # Reply lookup: arbitration id → (kind, target indices)
-        self._enc_slot: dict[tuple[int, int], tuple[int, ...]] = {}
-        for (bus, jmc), chans in boards.items():
-            for pair in range((len(chans) + 1) // 2):
-                rid = ENC_REPLY_BASE + jmc + PAIR_STRIDE * pair
-                self._enc_slot[(bus, rid)] = tuple(chans[2 * pair : 2 * pair + 2])
-        self._status_slot = {
-            (bus, STATUS_REPLY_BASE + jmc): chans for (bus, jmc), chans in boards.items()
-        }
-        self._current_slot = {
-            (bus, CURRENT_REPLY_BASE + jmc): chans for (bus, jmc), chans in boards.items()
-        }
-        self._sensor_slot: dict[tuple[int, int], tuple[str, int]] = {}
-        self._tx_slots: dict[int, list[int | can.Message]] = {}  # ref row index or message
-        self._housekeeping: dict[int, list[can.Message]] = {}
-        for bus in sorted({b for b, _ in boards} | {s.can for s in sensors.sensors}):
-            plan = BusPlan(bus, period_s=period_s, bitrate=bitrate)
-            slots: list[int | can.Message] = []
-            hk: list[can.Message] = []
-            tx: list[tuple[str, int, int]] = []
-            rx: list[tuple[str, int, int]] = []
-            for (b, jmc), chans in boards.items():
-                if b != bus:
-                    continue
-                npairs = (len(chans) + 1) // 2
-                for pair in range(npairs):
-                    tx.append(("ref", REF_BASE + jmc + PAIR_STRIDE * pair, jmc))
-                    slots.append(self._ref_rows.index((bus, jmc, pair)))
-                tx.append(("enc_req", CMD_ID, jmc))
-                slots.append(encode_enc_request(jmc))
-                hk += [encode_status_request(jmc), encode_current_request(jmc)]
-                for pair in range(npairs):
-                    rx.append(("enc_reply", ENC_REPLY_BASE + jmc + PAIR_STRIDE * pair, jmc))
-            for s in sensors.sensors:
-                if s.can != bus or not s.active:
-                    continue
-                if s.kind == "ft":
-                    tx.append(("ft_req", SENSOR_REQ_ID, s.board))
-                    slots.append(encode_sensor_request(s.board, SENSOR_FT))
-                    rx.append(("ft_reply", FT_REPLY_BASE + s.board, s.board))
-                    self._sensor_slot[(bus, FT_REPLY_BASE + s.board)] = (
-                        "ft",
-                        FT_NAMES.index(s.name),
-                    )
-                elif s.kind == "imu":
-                    tx.append(("tilt_req", SENSOR_REQ_ID, s.board))
-                    slots.append(encode_sensor_request(s.board, SENSOR_TILT))
-                    k = IMU_NAMES.index(s.name)
-                    rx.append(("tilt_reply", TILT_REPLY_BASE + s.board, s.board))
-                    self._sensor_slot[(bus, TILT_REPLY_BASE + s.board)] = ("acc", k)
-                    if s.name == "IMU":
-                        rx.append(("gyro_reply", GYRO_REPLY_BASE + s.board, s.board))
-                        self._sensor_slot[(bus, GYRO_REPLY_BASE + s.board)] = ("gyro", k)
-                else:
-                    tx.append(("power_req", SENSOR_REQ_ID, s.board))
-                    slots.append(encode_sensor_request(s.board, SENSOR_POWER))
-                    rx.append(("power_reply", POWER_REPLY_ID, s.board))
-                    self._sensor_slot[(bus, POWER_REPLY_ID)] = ("power", 0)
-            step = period_s / max(len(tx), 1)
-            plan.frames = [
-                PlannedFrame(kind, fid, board, True, round(i * step, 9))
-                for i, (kind, fid, board) in enumerate(tx)
-            ] + [PlannedFrame(kind, fid, board, False) for kind, fid, board in rx]
-            self.buses[bus] = plan
-            self._tx_slots[bus] = slots
-            self._housekeeping[bus] = hk
-        self._ref_bus = np.array([bus for bus, _, _ in self._ref_rows])
-        self._scale = joints.rad_per_count
-        self._offset = np.array([j.ref_enc for j in joints.joints], dtype=np.int64)
-
-    def __repr__(self) -> str:
-        loads = ", ".join(
-            f"can{b}: {len(p.frames)} frames, load {p.load:.0%}" for b, p in self.buses.items()
-        )
-        return f"CyclePlan({loads})"
-
-    def report(self) -> str:
-        """One line per bus: frame counts and load against the 108-bit budget."""
-        lines = []
-        for b, p in self.buses.items():
-            lines.append(
-                f"can{b}: {len(p.tx_frames)} sent + {len(p.frames) - len(p.tx_frames)} replies "
-                f"= {len(p.frames)} frames × {FRAME_BITS} bits per {p.period_s * 1e3:g} ms "
-                f"at {p.bitrate / 1e6:g} Mbit/s: load {p.load:.1%}"
-                + ("" if p.load <= 1.0 else "  OVER BUDGET")
-            )
-        return "\n".join(lines)
-
-    def within_budget(self) -> bool:
-        """True if every bus's load is at most 100 %."""
-        return all(p.load <= 1.0 for p in self.buses.values())
-
-    @property
-    def max_frames(self) -> int:
-        """Frames that fit in one period on one bus at 108 bits each."""
-        p = next(iter(self.buses.values()))
-        return int(p.bitrate * p.period_s // FRAME_BITS)
-
-    def encode(
-        self,
-        ref_rad: np.ndarray,
-        duty_pct: np.ndarray | None = None,
-        pwm_mask: np.ndarray | None = None,
-    ) -> dict[int, list[can.Message]]:
-        """The frames to send this cycle, per bus, in the order of `BusPlan.tx_frames`.
-
-        A motor pair whose joints are all in PWM mode gets a PWM frame in place of its
-        reference frame; a pair with one PWM joint (the wrist roll on a finger board) gets
-        both, the PWM frame right after the reference frame.
-
-        Args:
-            ref_rad: references of the 40 joints [rad].
-            duty_pct: duty of the 40 joints [%]; needed with ``pwm_mask``.
-            pwm_mask: (40,) bool, True for joints in PWM (compliant) mode.
-
-        Returns:
-            bus → messages; send message i at ``tx_frames[i].offset_s`` (extra PWM frames
-            of mixed pairs go with their reference frame).
-        """
-        counts = np.rint(np.asarray(ref_rad, float) / self._scale).astype(np.int64) + self._offset
-        pair_counts = np.where(self._ref_valid, counts[self._ref_index], 0)
-        words = to_sign_magnitude(pair_counts.ravel())
-        payload = words.astype("<u4").view(np.uint8).reshape(-1, 2, 4)[:, :, :3]
-        payload = payload.reshape(-1, 6).tobytes()
-        pwm_rows: dict[int, tuple[can.Message, bool]] = {}
-        if pwm_mask is not None:
-            mask = np.asarray(pwm_mask, bool)
-            row_mask = self._ref_valid & mask[self._ref_index]
-            for i in np.flatnonzero(row_mask.any(axis=1)):
-                _, jmc, pair = self._ref_rows[i]
-                idx = self._ref_index[i]
-                m = int(row_mask[i, 0]) | int(row_mask[i, 1]) << 1
-                d = tuple(float(duty_pct[j]) if row_mask[i, k] else 0.0 for k, j in enumerate(idx))
-                only_pwm = bool(np.all(row_mask[i] == self._ref_valid[i]))
-                pwm_rows[int(i)] = (encode_pwm(jmc, d, pair, m), only_pwm)
-        out: dict[int, list[can.Message]] = {}
-        for bus, slots in self._tx_slots.items():
-            msgs = out[bus] = []
-            for slot in slots:
-                if not isinstance(slot, int):
-                    msgs.append(slot)
-                    continue
-                pwm = pwm_rows.get(slot)
-                if pwm is None or not pwm[1]:
-                    msgs.append(_msg(self._ref_ids[slot], payload[6 * slot : 6 * slot + 6]))
-                if pwm is not None:
-                    msgs.append(pwm[0])
-        return out
-
-    def housekeeping(self, cycle: int, used: dict[int, int] | None = None) -> dict[int, list]:
-        """Status and current requests that fit in this cycle's spare bus time.
-
-        Each request costs two frames (request and reply). The requests go round robin over
-        every board, so over a few cycles each board's status and current are read.
-
-        Args:
-            cycle: cycle counter.
-            used: frames per bus already planned this cycle (default: the plan's frames).
-        """
-        out = {}
-        for bus, reqs in self._housekeeping.items():
-            n_used = len(self.buses[bus].frames) if used is None else used[bus]
-            fit = max(self.max_frames - n_used, 0) // 2
-            if reqs and fit:
-                start = (cycle * fit) % len(reqs)
-                out[bus] = [reqs[(start + k) % len(reqs)] for k in range(min(fit, len(reqs)))]
-        return out
-
-    def decode(
-        self, frames: dict[int, list[can.Message]] | list[tuple[int, can.Message]]
-    ) -> CycleReadings:
-        """Fold one cycle's received frames into readings (vectorised where it matters).
-
-        Args:
-            frames: bus → received messages, or a list of (bus, message).
-        """
-        items = (
-            [(b, m) for b, ms in frames.items() for m in ms] if isinstance(frames, dict) else frames
-        )
-        n = NUM_JOINTS
-        enc_chunks: list[bytes] = []
-        enc_targets: list[int] = []
-        r = CycleReadings(
-            enc=np.zeros(n, np.int64),
-            pos_rad=np.full(n, np.nan),
-            got_enc=np.zeros(n, bool),
-            status=np.full(n, int(StatusFlag.NO_REPLY), np.uint32),
-            current_a=np.full(n, np.nan),
-            ft=np.full((NUM_FT, 3), np.nan),
-            imu=np.full((NUM_IMU, 6), np.nan),
-            power=np.full(3, np.nan),
-        )
-        for bus, m in items:
-            key = (bus, m.arbitration_id)
-            slot = self._enc_slot.get(key)
-            if slot is not None:
-                data = bytes(m.data)
-                for k, j in enumerate(slot):
-                    if j >= 0 and 4 * k + 4 <= len(data):
-                        enc_chunks.append(data[4 * k : 4 * k + 4])
-                        enc_targets.append(j)
-                continue
-            sensor = self._sensor_slot.get(key)
-            if sensor is not None:
-                kind, k = sensor
-                if kind == "ft":
-                    r.ft[k] = decode_ft_reply(m)[1]
-                elif kind == "acc":
-                    r.imu[k, :3] = decode_imu_reply(m)[2]
-                elif kind == "gyro":
-                    r.imu[k, 3:] = decode_imu_reply(m)[2]
-                else:
-                    r.power[:] = decode_power_reply(m)
-                continue
-            chans = self._status_slot.get(key)
-            if chans is not None:
-                for j, s in zip(chans, decode_status_reply(m)[1], strict=False):
-                    if j >= 0:
-                        r.status[j] = int(board_status_to_flags(s))
-                continue
-            chans = self._current_slot.get(key)
-            if chans is not None:
-                for j, a in zip(chans, decode_current_reply(m)[1], strict=False):
-                    if j >= 0:
-                        r.current_a[j] = a
-                continue
-            r.unknown += 1
-        if enc_targets:
-            idx = np.array(enc_targets)
-            counts = np.frombuffer(b"".join(enc_chunks), "<i4").astype(np.int64)
-            r.enc[idx] = counts
-            r.got_enc[idx] = True
-            r.pos_rad[idx] = (counts - self._offset[idx]) * self._scale[idx]
-        return r
