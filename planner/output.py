@@ -6,14 +6,7 @@ per segment the primitive, phase, rung, lines, holds in contact and moving limbs
 arm a run-length position/PWM schedule; the final holds; planner metrics, seed, timings
 and version.
 
-PWM (compliant) mode is scheduled for an arm while its hand holds a rail or its palm is
-within `PWM_RAIL_DISTANCE_M` of its rail's axis (closing, opening, the first and last
-centimetres of a reach); position mode while the hand moves through the air, and
-throughout a plan made for rigid arms (``arm_strategy`` ``position``).
-
-Size: one pass over the timed lines builds both files: the trajectory, and the
-sidecar's segments, arm-mode schedule, feed-forward torques and metrics, which all
-read the same timed configurations.
+The arms' position/PWM schedule is `planner.arm_schedule`'s.
 """
 
 from __future__ import annotations
@@ -28,9 +21,9 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pinocchio as pin
 
-from planner.statics.arm_capacity import DEFAULT_ARM_STRATEGY, arms_comply_while_gripping
+from planner.arm_schedule import PWM_RAIL_DISTANCE_M, arm_schedule
+from planner.statics.arm_capacity import DEFAULT_ARM_STRATEGY
 from planner.verify.check import CLEARANCE_EVERY_LINES  # the verifier's sampling
 from robot.constants import DAEMON_RATE_HZ
 from robot.joints import ARM_JOINTS
@@ -40,7 +33,6 @@ from robot.plan_sidecar import (
     PlanSidecar,
     Segment,
     feedforward_rows,
-    hand_holding_lines,
     sidecar_path,
     write_sidecar,
 )
@@ -57,12 +49,9 @@ log = logging.getLogger(__name__)
 #: ``progress(phase, done, total)``: how far `write_plan` is.
 OutputProgress = Callable[[str, int, int], None]
 
-__all__ = ["PWM_RAIL_DISTANCE_M", "PlanOutput", "arm_mode_runs", "held_palm_turn_rad",
-           "palm_poses", "palm_rail_distances", "planner_version", "segment_paths", "step_groups",
-           "write_plan"]
+__all__ = ["FEEDFORWARD_EVERY_LINES", "PlanOutput", "arm_feedforward", "planner_version",
+           "segment_paths", "step_groups", "write_plan"]
 
-#: An arm is compliant (PWM) while its palm is this close to its rail's axis [m].
-PWM_RAIL_DISTANCE_M = 0.03
 #: The arms' feed-forward torques are sampled every this-many lines (0.1 s at 200 Hz:
 #: a quasi-static climb's load shifts over seconds).
 FEEDFORWARD_EVERY_LINES = 20
@@ -196,81 +185,6 @@ def _holds_after_steps(result: SearchResult, kin) -> list[dict[str, Hold]]:
     return out
 
 
-def palm_poses(configs: np.ndarray, kin) -> dict[str, np.ndarray]:
-    """Each palm's pose per line, arm → (N, 4, 4): one forward kinematics per line.
-
-    Args:
-        configs: (N, nq) full configurations.
-        kin: `HuboKinematics` (palm frames ``L_palm``/``R_palm``).
-    """
-    frames = {side: kin.model.getFrameId("L_palm" if side == "left" else "R_palm")
-              for side in ARMS}
-    out = {side: np.empty((len(configs), 4, 4)) for side in ARMS}
-    for i, q in enumerate(configs):
-        pin.framesForwardKinematics(kin.model, kin.data, q)
-        for side, fid in frames.items():
-            out[side][i] = kin.data.oMf[fid].homogeneous
-    return out
-
-
-def palm_rail_distances(palms: dict[str, np.ndarray], geom) -> dict[str, np.ndarray]:
-    """Distance of each palm to its own side's rail axis, per line [m].
-
-    Args:
-        palms: arm → (N, 4, 4) palm poses (`palm_poses`).
-        geom: `LadderGeometry` (``closest_rail_point``).
-    """
-    return {side: np.linalg.norm(T[:, :3, 3] - geom.closest_rail_point(side, T[:, :3, 3]),
-                                 axis=1) for side, T in palms.items()}
-
-
-def held_palm_turn_rad(palms: dict[str, np.ndarray], holding: dict[str, np.ndarray]
-                       ) -> dict[str, np.ndarray]:
-    """How far each held palm has turned since its hand closed on the rail, per line [rad].
-
-    The holds fix a palm's position and grip axis only, so a held hand may turn about its
-    rail from line to line, as a hooked hand does (`daemon.sim.grasp_latch`: the turn costs
-    the friction of the load across the rail); a grip that squeezed the rail would resist
-    it with more than a compliant arm gives.
-
-    Args:
-        palms: arm → (N, 4, 4) palm poses (`palm_poses`).
-        holding: arm → bool (N,) lines on which that hand holds its rail.
-
-    Returns:
-        arm → (N,) rotation angle of the palm from its orientation on the first line of
-        the current hold; 0 where the hand holds nothing.
-    """
-    out = {}
-    for side, held in holding.items():
-        R = palms[side][:, :3, :3]
-        grasped = held & ~np.r_[False, held[:-1]]  # the hand has just closed on its rail
-        first = np.maximum.accumulate(np.where(grasped, np.arange(len(held)), 0))
-        cos = (np.einsum("nij,nij->n", R[first], R) - 1.0) / 2.0  # trace(R0ᵀ R)
-        out[side] = np.where(held, np.arccos(np.clip(cos, -1.0, 1.0)), 0.0)
-    return out
-
-
-def arm_mode_runs(pwm: np.ndarray) -> list[tuple[int, int, str]]:
-    """Run-length schedule of one arm from a per-line PWM flag.
-
-    Args:
-        pwm: (N,) True where the arm is compliant.
-
-    Returns:
-        ``[(first_line, last_line, "position"|"pwm"), ...]``, 1-based inclusive, covering
-        lines 1..N in order.
-    """
-    pwm = np.asarray(pwm, dtype=bool)
-    if pwm.size == 0:
-        return []
-    change = np.flatnonzero(pwm[1:] != pwm[:-1]) + 1
-    starts = np.concatenate([[0], change])
-    ends = np.concatenate([change, [len(pwm)]])
-    return [(int(a) + 1, int(b), "pwm" if pwm[a] else "position") for a, b in zip(starts, ends,
-                                                                                    strict=True)]
-
-
 def _sidecar_segments(result: SearchResult, timed: TimedPlan,
                       after: list[dict[str, Hold]]) -> list[Segment]:
     step_of_segment = {i: g for g, idx in enumerate(step_groups(result.segments)) for i in idx}
@@ -376,6 +290,20 @@ def _metrics(result: SearchResult, planner: ClimbPlanner, timed: TimedPlan,
     }
 
 
+def _arm_metrics(planner: ClimbPlanner, turn: dict[str, np.ndarray]) -> dict:
+    """The sidecar metrics of the arms' schedule and the planner's arm and foot
+    settings."""
+    return {
+        "palm_rail_pwm_distance_m": PWM_RAIL_DISTANCE_M,
+        "max_held_palm_turn_rad": {side: float(turn[side].max()) for side in ARMS},
+        "max_held_palm_turn_line": {side: int(np.argmax(turn[side])) + 1 for side in ARMS},
+        "arm_strategy": planner.config.arm_strategy,
+        "position_torque_share": planner.config.position_torque_share,
+        "foot_cop_margin_m": planner.config.foot_cop_margin_m,
+        "foot_friction_share": planner.config.foot_friction_share,
+    }
+
+
 def write_plan(result: SearchResult, planner: ClimbPlanner, out_traj: str | os.PathLike,
                rate_hz: float = DAEMON_RATE_HZ, timings: dict[str, float] | None = None, *,
                dwell_s: float = 0.5, q_start: np.ndarray | None = None,
@@ -425,24 +353,11 @@ def write_plan(result: SearchResult, planner: ClimbPlanner, out_traj: str | os.P
     after = _holds_after_steps(result, kin)
     segments = _sidecar_segments(result, timed, after)
     phase("palm poses", 0, timed.line_count)
-    palms = palm_poses(timed.configs, kin)
-    distances = palm_rail_distances(palms, planner.geom)
-    # A plan for rigid arms loads them beyond what a compliant arm gives: never PWM.
-    comply = arms_comply_while_gripping(planner.config.arm_strategy)
-    holding = {side: hand_holding_lines(segments, timed.line_count, side) for side in ARMS}
-    arm_modes = {side: arm_mode_runs((holding[side] | (distances[side] <= PWM_RAIL_DISTANCE_M))
-                                     & comply) for side in ARMS}
-    turn = held_palm_turn_rad(palms, holding)
+    arm_modes, turn = arm_schedule(planner, segments, timed)
     feedforward = arm_feedforward(result, timed, after, planner.checker)
     metrics = _metrics(result, planner, timed, segments, clearance_every, progress)
     phase("writing", 0, 1)
-    metrics["palm_rail_pwm_distance_m"] = PWM_RAIL_DISTANCE_M
-    metrics["max_held_palm_turn_rad"] = {side: float(turn[side].max()) for side in ARMS}
-    metrics["max_held_palm_turn_line"] = {side: int(np.argmax(turn[side])) + 1 for side in ARMS}
-    metrics["arm_strategy"] = planner.config.arm_strategy
-    metrics["position_torque_share"] = planner.config.position_torque_share
-    metrics["foot_cop_margin_m"] = planner.config.foot_cop_margin_m
-    metrics["foot_friction_share"] = planner.config.foot_friction_share
+    metrics.update(_arm_metrics(planner, turn))
     out_traj = Path(out_traj)
     write_trajectory(out_traj, timed.columns_rad)
     all_timings = dict(timings or {})

@@ -192,7 +192,6 @@ def _parse(text: str, source: str, rate_hz: float, robot: str, check_speed: bool
            clamp_tol_rad: float) -> tuple[np.ndarray, tuple[ClampedJoint, ...]]:
     """`parse_trajectory`, clamping values within ``clamp_tol_rad`` beyond a limit."""
     limits = joint_limits(robot)
-    tol = max(LIMIT_TOLERANCE_RAD, clamp_tol_rad)
     clamped: dict[int, list[tuple[int, float, float, float]]] = {}
     problems: list[str] = []
     rows: list[np.ndarray] = []
@@ -203,67 +202,92 @@ def _parse(text: str, source: str, rate_hz: float, robot: str, check_speed: bool
     if not lines:
         raise TrajectoryFileError(source, [f"{source}:1:1: the file has no trajectory lines"])
     for lineno, raw in enumerate(lines, start=1):
-        line = raw.rstrip("\r")
-        where = f"{source}:{lineno}"
-        if len(line) > MAX_LINE_CHARS:
-            problems.append(f"{where}:{MAX_LINE_CHARS + 1}: line is {len(line)} characters; "
-                            f"hubo-read-trajectory reads at most {MAX_LINE_CHARS} per line")
-            continue
-        tokens = _token_columns(line)
-        if not tokens:
-            problems.append(f"{where}:1: empty line; every line must hold {NUM_JOINTS} values")
-            continue
-        values = np.empty(NUM_JOINTS)
-        ok = True
-        for k, (col, tok) in enumerate(tokens[:NUM_JOINTS]):
-            try:
-                v = float(tok)
-            except ValueError:
-                joint = JOINT_NAMES[k]
-                hint = " (a header line of joint names is not allowed)" if tok in JOINT_NAMES \
-                    else ""
-                problems.append(f"{where}:{col}: column {k + 1} ({joint}): {tok!r} is not a "
-                                f"number{hint}")
-                ok = False
-                break
-            if not math.isfinite(v):
-                problems.append(f"{where}:{col}: column {k + 1} ({JOINT_NAMES[k]}): {tok} is "
-                                "not finite")
-                ok = False
-                continue
-            lo, hi = limits.lower_rad[k], limits.upper_rad[k]
-            if v < lo - tol or v > hi + tol:
-                hint = "" if tol <= LIMIT_TOLERANCE_RAD else \
-                    f" by more than the --clamp-limits tolerance {clamp_tol_rad:g} rad"
-                problems.append(f"{where}:{col}: column {k + 1} ({JOINT_NAMES[k]}): {v:.6g} rad "
-                                f"is outside the joint limits [{lo:.4g}, {hi:.4g}] rad{hint}")
-                ok = False
-            elif clamp_tol_rad > 0.0 and (v < lo - LIMIT_TOLERANCE_RAD
-                                          or v > hi + LIMIT_TOLERANCE_RAD):
-                limit = lo if v < lo else hi
-                clamped.setdefault(k, []).append((lineno, abs(v - limit), v, limit))
-                v = limit
-            values[k] = v
-        if ok and len(tokens) != NUM_JOINTS:
-            col = tokens[-1][0] if len(tokens) < NUM_JOINTS else tokens[NUM_JOINTS][0]
-            problems.append(f"{where}:{col}: {len(tokens)} columns; expected {NUM_JOINTS}")
-            ok = False
-        if ok:
+        values = _parse_line(raw.rstrip("\r"), f"{source}:{lineno}", lineno, limits,
+                             clamp_tol_rad, clamped, problems)
+        if values is not None:
             rows.append(values)
             row_lines.append(lineno)
     if check_speed and len(rows) > 1 and not problems:
-        q = np.vstack(rows)
-        speed = np.abs(np.diff(q, axis=0)) * rate_hz
-        bad = np.argwhere(speed > limits.velocity_max_rad_s + 1e-9)
-        for r, k in bad[:50]:
-            col = _token_columns(lines[row_lines[r + 1] - 1])[k][0]
-            problems.append(
-                f"{source}:{row_lines[r + 1]}:{col}: column {k + 1} ({JOINT_NAMES[k]}): step "
-                f"of {q[r + 1, k] - q[r, k]:+.4g} rad from the previous line is "
-                f"{speed[r, k]:.3g} rad/s at {rate_hz:g} Hz; the limit is "
-                f"{limits.velocity_max_rad_s[k]:g} rad/s")
+        problems += _speed_problems(np.vstack(rows), row_lines, lines, source, rate_hz, limits)
     if problems:
         raise TrajectoryFileError(source, problems)
+    return np.vstack(rows), _clamp_report(clamped)
+
+
+def _parse_line(line: str, where: str, lineno: int, limits, clamp_tol_rad: float,
+                clamped: dict[int, list[tuple[int, float, float, float]]],
+                problems: list[str]) -> np.ndarray | None:
+    """One line's 40 values [rad], or None if it has a problem (appended to
+    ``problems`` as ``FILE:LINE:COLUMN: ...``). A value within ``clamp_tol_rad`` beyond
+    a limit is moved onto it and recorded in ``clamped`` per joint as (line, overshoot,
+    value, limit)."""
+    tol = max(LIMIT_TOLERANCE_RAD, clamp_tol_rad)
+    if len(line) > MAX_LINE_CHARS:
+        problems.append(f"{where}:{MAX_LINE_CHARS + 1}: line is {len(line)} characters; "
+                        f"hubo-read-trajectory reads at most {MAX_LINE_CHARS} per line")
+        return None
+    tokens = _token_columns(line)
+    if not tokens:
+        problems.append(f"{where}:1: empty line; every line must hold {NUM_JOINTS} values")
+        return None
+    values = np.empty(NUM_JOINTS)
+    ok = True
+    for k, (col, tok) in enumerate(tokens[:NUM_JOINTS]):
+        try:
+            v = float(tok)
+        except ValueError:
+            joint = JOINT_NAMES[k]
+            hint = " (a header line of joint names is not allowed)" if tok in JOINT_NAMES \
+                else ""
+            problems.append(f"{where}:{col}: column {k + 1} ({joint}): {tok!r} is not a "
+                            f"number{hint}")
+            return None
+        if not math.isfinite(v):
+            problems.append(f"{where}:{col}: column {k + 1} ({JOINT_NAMES[k]}): {tok} is "
+                            "not finite")
+            ok = False
+            continue
+        lo, hi = limits.lower_rad[k], limits.upper_rad[k]
+        if v < lo - tol or v > hi + tol:
+            hint = "" if tol <= LIMIT_TOLERANCE_RAD else \
+                f" by more than the --clamp-limits tolerance {clamp_tol_rad:g} rad"
+            problems.append(f"{where}:{col}: column {k + 1} ({JOINT_NAMES[k]}): {v:.6g} rad "
+                            f"is outside the joint limits [{lo:.4g}, {hi:.4g}] rad{hint}")
+            ok = False
+        elif clamp_tol_rad > 0.0 and (v < lo - LIMIT_TOLERANCE_RAD
+                                      or v > hi + LIMIT_TOLERANCE_RAD):
+            limit = lo if v < lo else hi
+            clamped.setdefault(k, []).append((lineno, abs(v - limit), v, limit))
+            v = limit
+        values[k] = v
+    if ok and len(tokens) != NUM_JOINTS:
+        col = tokens[-1][0] if len(tokens) < NUM_JOINTS else tokens[NUM_JOINTS][0]
+        problems.append(f"{where}:{col}: {len(tokens)} columns; expected {NUM_JOINTS}")
+        ok = False
+    return values if ok else None
+
+
+def _speed_problems(q: np.ndarray, row_lines: list[int], lines: list[str], source: str,
+                    rate_hz: float, limits) -> list[str]:
+    """The first 50 steps between consecutive lines faster than a joint's velocity limit
+    at ``rate_hz``, each named ``FILE:LINE:COLUMN``."""
+    problems = []
+    speed = np.abs(np.diff(q, axis=0)) * rate_hz
+    bad = np.argwhere(speed > limits.velocity_max_rad_s + 1e-9)
+    for r, k in bad[:50]:
+        col = _token_columns(lines[row_lines[r + 1] - 1])[k][0]
+        problems.append(
+            f"{source}:{row_lines[r + 1]}:{col}: column {k + 1} ({JOINT_NAMES[k]}): step "
+            f"of {q[r + 1, k] - q[r, k]:+.4g} rad from the previous line is "
+            f"{speed[r, k]:.3g} rad/s at {rate_hz:g} Hz; the limit is "
+            f"{limits.velocity_max_rad_s[k]:g} rad/s")
+    return problems
+
+
+def _clamp_report(clamped: dict[int, list[tuple[int, float, float, float]]]
+                  ) -> tuple[ClampedJoint, ...]:
+    """Per clamped joint, in column order: the lines it was clamped on and its worst
+    overshoot."""
     report = []
     for k in sorted(clamped):
         entries = clamped[k]
@@ -271,7 +295,7 @@ def _parse(text: str, source: str, rate_hz: float, robot: str, check_speed: bool
         report.append(ClampedJoint(JOINT_NAMES[k], tuple(e[0] for e in entries),
                                    float(worst[1]), worst[0], float(worst[2]),
                                    float(worst[3])))
-    return np.vstack(rows), tuple(report)
+    return tuple(report)
 
 
 def read_trajectory(path: str | os.PathLike, rate_hz: float, robot: str = "drc-hubo",

@@ -1,5 +1,5 @@
-"""planner.output: the trajectory and sidecar of a plan (round trip, mode schedule,
-determinism)."""
+"""planner.output and planner.arm_schedule: the trajectory and sidecar of a plan (round
+trip, mode schedule, determinism)."""
 
 from __future__ import annotations
 
@@ -16,14 +16,10 @@ sys.path.insert(0, str(Path(__file__).parent))
 from synthetic_plan import synthetic_plan  # noqa: E402
 
 from ladders.loader import parse_ladder_yaml  # noqa: E402
-from planner import output  # noqa: E402
+from planner import arm_schedule, output  # noqa: E402
+from planner.arm_schedule import PWM_RAIL_DISTANCE_M, arm_mode_runs  # noqa: E402
 from planner.contacts import Hold  # noqa: E402
-from planner.output import (  # noqa: E402
-    FEEDFORWARD_EVERY_LINES,
-    PWM_RAIL_DISTANCE_M,
-    arm_mode_runs,
-    write_plan,
-)
+from planner.output import FEEDFORWARD_EVERY_LINES, write_plan  # noqa: E402
 from planner.search import SearchResult  # noqa: E402
 from robot.joints import ARM_JOINTS  # noqa: E402
 from robot.plan_sidecar import (  # noqa: E402
@@ -106,7 +102,7 @@ def test_arm_mode_runs():
 
 def test_palm_distances_match_the_rail_geometry(plan):
     planner, result, q0 = plan
-    d = output.palm_rail_distances(output.palm_poses(np.array([q0]), planner.kin),
+    d = arm_schedule.palm_rail_distances(arm_schedule.palm_poses(np.array([q0]), planner.kin),
                                    planner.geom)
     palm = planner.kin.frame_pose(q0, "L_palm")[:3, 3]
     expect = np.linalg.norm(palm - planner.geom.closest_rail_point("left", palm))
@@ -121,7 +117,7 @@ def test_held_palm_turn_counts_from_each_grasp(plan):
     wrist = kin.q_index["LWR"]
     configs[:, wrist] += [0.0, 0.1, 0.2, 0.35, 0.5, 0.5, 0.6, 0.9]
     held = np.array([0, 1, 1, 1, 0, 1, 1, 0], dtype=bool)  # two holds: lines 2–4, 6–7
-    turn = output.held_palm_turn_rad(output.palm_poses(configs, kin),
+    turn = arm_schedule.held_palm_turn_rad(arm_schedule.palm_poses(configs, kin),
                                      {"left": held, "right": held & False})
     np.testing.assert_allclose(turn["left"], [0, 0, 0.1, 0.25, 0, 0, 0.1, 0], atol=1e-9)
     assert not turn["right"].any()
@@ -134,7 +130,7 @@ def _closing_on_the_rails(result, monkeypatch) -> SearchResult:
         n = len(palms["left"])
         return {"left": np.linspace(0.10, 0.0, n), "right": np.full(n, 0.2)}
 
-    monkeypatch.setattr(output, "palm_rail_distances", fake)
+    monkeypatch.setattr(arm_schedule, "palm_rail_distances", fake)
     grasp = result.segments[1]
     T = np.eye(4)
     rail = Hold("right_hand", "rail_right", T, np.zeros((2, 3)), np.tile([0, 0, 1.0], (2, 1)))
@@ -160,7 +156,7 @@ def test_mode_schedule_from_palm_distance_and_grasps(plan, tmp_path, monkeypatch
     # the sidecar reports how far each held palm turns on its rail (its fingers only
     # close here, so neither turns)
     holding = {arm: hand_holding_lines(sc.segments, n, arm) for arm in ("left", "right")}
-    turn = output.held_palm_turn_rad(output.palm_poses(out.timed.configs, planner.kin),
+    turn = arm_schedule.held_palm_turn_rad(arm_schedule.palm_poses(out.timed.configs, planner.kin),
                                      holding)
     assert sc.metrics["max_held_palm_turn_rad"] == {arm: t.max() for arm, t in turn.items()}
 

@@ -47,7 +47,7 @@ default, a fifth of their limit:
 
 - not at the limit: a grip that squeezed with all five fingers at their limit (8.3 N·m
   about the rail) does not turn, while the plan turns a held hand on its rail by up to
-  55° as the body rises past it (`planner.output`'s held-palm turn): the arm then folded
+  55° as the body rises past it (`planner.arm_schedule`'s held-palm turn): the arm then folded
   elsewhere, bent the grip open and the hand dropped the rail (DRC seed 1, 72.0 s);
 - not zero: a hook that does not squeeze holds along an inclined rail only what the
   load across it presses, and the planned hand forces push along the rail (the planner's
