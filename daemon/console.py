@@ -34,12 +34,13 @@ Exit codes: 0 every command done, 1 the daemon did not answer, 2 a command was r
 from __future__ import annotations
 
 import argparse
+import functools
 import sys
 import time
 
 import numpy as np
 
-from robot.errors import HuboLadderError, InputError, parse_finite
+from robot.errors import HuboLadderError, InputError, parse_finite, run_cli
 
 __all__ = ["Console", "main"]
 
@@ -219,30 +220,36 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("-c", dest="commands", metavar="CMDS",
                    help="run these ';'-separated commands instead of reading stdin")
     args = p.parse_args(argv)
+    return run_cli("hubo-console", lambda: _run(args))
+
+
+def _run(args: argparse.Namespace) -> int:
+    """Run the commands of ``-c`` or stdin until ``quit`` or the end, each through
+    `run_cli`: a refused command is reported and the next one runs. Returns the worst
+    command's exit code (2 refused, 1 the daemon did not answer)."""
     lines = args.commands.split(";") if args.commands is not None else None
     console = Console(args.instance, robot=args.robot)
     code = 0
+    quit_ = False
+
+    def command(line: str) -> int:
+        nonlocal quit_
+        quit_ = not console.execute(line)
+        return 0
+
     tty = lines is None and sys.stdin.isatty()
     try:
         source = lines if lines is not None else sys.stdin
         if tty:
             print("hubo-console: type help for the commands", file=sys.stderr)
-        while True:
+        while not quit_:
             if tty:
                 print("hubo> ", end="", file=sys.stderr, flush=True)
             line = next(iter(source), None) if lines is None else (
                 lines.pop(0) if lines else None)
             if line is None:
                 break
-            try:
-                if not console.execute(line):
-                    break
-            except InputError as exc:
-                print(f"hubo-console: {exc}", file=sys.stderr)
-                code = max(code, 2)
-            except HuboLadderError as exc:
-                print(f"hubo-console: {exc}", file=sys.stderr)
-                code = 1 if code == 0 else code
+            code = max(code, run_cli("hubo-console", functools.partial(command, line)))
     except KeyboardInterrupt:
         pass
     finally:

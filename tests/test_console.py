@@ -83,3 +83,19 @@ def test_gains_within_the_safety_limits_are_set(daemon):
                                                        "maxPWM RSP 7.9"]) == 0
     j = JOINT_INDEX["RSP"]
     assert (loop.gains.kp[j], loop.gains.kd[j], loop.gains.max_pwm_pct[j]) == (69.9, 9.9, 7.9)
+
+
+def test_a_refused_command_is_reported_and_the_next_one_runs(daemon, capsys):
+    instance, _, _ = daemon
+    assert console_main(["--instance", instance, "-c", "frobnicate; goto RKN 3.0; quit; "
+                                                       "bogus"]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert err[0].startswith("hubo-console: unknown command 'frobnicate'; commands: homeAll")
+    assert err[1].startswith("hubo-console: goto RKN 3 refused")
+    assert len(err) == 2  # quit ends the commands
+
+
+def test_no_daemon_is_a_one_line_failure(capsys):
+    assert console_main(["--instance", "console-nobody", "-c", "statusAll"]) == 1
+    err = capsys.readouterr().err
+    assert err.strip() == "hubo-console: no hubo-daemon is ticking on instance 'console-nobody'"

@@ -74,9 +74,11 @@ def _now() -> str:
 
 
 def _error_text(exc: BaseException) -> tuple[str, str]:
-    cause = exc.__cause__  # ProcessPoolExecutor: the worker's traceback as _RemoteTraceback
-    tb = str(cause) if cause is not None and "Traceback" in str(cause) else \
-        "".join(traceback.format_exception(exc))
+    """A job's error as one line and its traceback (the last 4,000 characters): the
+    worker's own, which ProcessPoolExecutor attaches as the cause's ``tb`` field
+    (``_RemoteTraceback``), else this process's."""
+    remote_tb = getattr(exc.__cause__, "tb", None)
+    tb = remote_tb if isinstance(remote_tb, str) else "".join(traceback.format_exception(exc))
     return f"{type(exc).__name__}: {exc}", tb[-4000:]
 
 
