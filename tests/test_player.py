@@ -8,9 +8,8 @@ import pytest
 from daemon.control_modes import TICK_S, RefMode
 from daemon.joint_control import JointController
 from daemon.pwm import default_drc_gains
+from execute.play.arm_modes import ArmModeSchedule, ModeScheduleError
 from execute.play.player import (
-    ArmModeSchedule,
-    ModeScheduleError,
     PlayerOptionError,
     PlayerOptions,
     PlayerStateError,

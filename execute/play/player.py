@@ -40,14 +40,16 @@ its stiffness towards the reference (kp) plus the feed-forward. The closed chain
 the rail leaves the arm's pose free (a hand turns on its rail, `daemon.sim.grasp_latch`),
 and the stiffness is what holds it there (docs/decisions/arm-feedforward.md).
 
-Size: one state machine (hubo-read-trajectory's: go-to-init, play, pause, finish)
-and the per-arm mode schedule and feed-forward it applies each tick.
+The per-arm schedule is `execute.play.arm_modes`'s.
+
+Size: one state machine (hubo-read-trajectory's: go-to-init, play, pause, finish) and
+what it applies each tick (the arms' modes, the feed-forward).
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from types import MappingProxyType
 
@@ -55,6 +57,7 @@ import numpy as np
 
 from daemon.control_modes import TICK_S, RefMode, default_filter_config, filter_reference
 from daemon.pwm import feedforward_duty_pct
+from execute.play.arm_modes import ArmModeSchedule, ModeScheduleError
 from robot.errors import HuboLadderError, InputError
 from robot.joints import ARM_JOINTS, NUM_JOINTS, joint_indices
 from robot.motors import MotorTable
@@ -65,8 +68,6 @@ __all__ = [
     "ALLOWED_RATES_HZ",
     "ARMS",
     "ARM_MODES",
-    "ArmModeSchedule",
-    "ModeScheduleError",
     "PlayerOptionError",
     "PlayerOptions",
     "PlayerStateError",
@@ -84,10 +85,6 @@ _EPS_LINES = 1e-9  # [lines] float slack so that t = k/f exactly lands on line k
 
 class PlayerOptionError(InputError):
     """A player option or the trajectory array is refused; names the option and range."""
-
-
-class ModeScheduleError(InputError):
-    """A per-arm mode schedule is malformed: names the arm, the run and the problem."""
 
 
 class PlayerStateError(HuboLadderError):
@@ -166,106 +163,6 @@ class PlayerOptions:
     def period_s(self) -> float:
         """Time per line [s]."""
         return 1.0 / self.rate_hz
-
-
-@dataclass(frozen=True, eq=False)
-class ArmModeSchedule:
-    """Per-arm PWM/position mode of every line of a trajectory.
-
-    Attributes:
-        pwm_by_line: arm → bool array (num_lines,), True where the arm is in PWM mode.
-    """
-
-    pwm_by_line: Mapping[str, np.ndarray]
-
-    @property
-    def num_lines(self) -> int:
-        """Number of trajectory lines covered."""
-        return len(next(iter(self.pwm_by_line.values())))
-
-    @classmethod
-    def all_position(cls, num_lines: int) -> ArmModeSchedule:
-        """Both arms in position mode on every line."""
-        return cls.from_runs({}, num_lines)
-
-    @classmethod
-    def from_runs(
-        cls,
-        runs: Mapping[str, Sequence[tuple[int, int, str]]],
-        num_lines: int,
-    ) -> ArmModeSchedule:
-        """Builds the schedule from the sidecar's run-length lists.
-
-        Args:
-            runs: ``{"left": [(1, 120, "position"), (121, 400, "pwm"), ...], "right": ...}``;
-                1-based inclusive line numbers, in order, covering 1..num_lines exactly once.
-                An arm that is absent is in position mode throughout.
-            num_lines: lines in the trajectory.
-
-        Raises:
-            ModeScheduleError: unknown arm or mode, a malformed run, a gap, an overlap, or
-                a run outside 1..num_lines; every problem is listed.
-        """
-        problems: list[str] = []
-        unknown = sorted(set(runs) - set(ARMS))
-        if unknown:
-            problems.append(f"unknown arm(s) {unknown}; allowed: {', '.join(ARMS)}")
-        table = {}
-        for arm in ARMS:
-            pwm = np.zeros(num_lines, dtype=bool)
-            if arm in runs:
-                problems += _fill_runs(arm, runs[arm], num_lines, pwm)
-            pwm.setflags(write=False)
-            table[arm] = pwm
-        if problems:
-            raise ModeScheduleError("mode schedule: " + "\n".join(problems))
-        return cls(MappingProxyType(table))
-
-    def to_runs(self) -> dict[str, list[tuple[int, int, str]]]:
-        """The run-length form again (1-based inclusive lines), e.g. for a sidecar."""
-        out = {}
-        for arm, pwm in self.pwm_by_line.items():
-            edges = np.flatnonzero(np.diff(pwm.astype(np.int8))) + 1
-            starts = np.concatenate([[0], edges])
-            ends = np.concatenate([edges, [len(pwm)]])
-            out[arm] = [
-                (int(a) + 1, int(b), ARM_MODES[int(pwm[a])])
-                for a, b in zip(starts, ends, strict=True)
-            ]
-        return out
-
-
-def _fill_runs(
-    arm: str, runs: Iterable[tuple[int, int, str]], num_lines: int, pwm: np.ndarray
-) -> list[str]:
-    problems: list[str] = []
-    expected = 1
-    for n, run in enumerate(runs, start=1):
-        where = f"{arm} run {n} {run!r}"
-        try:
-            first, last, mode = run
-        except (TypeError, ValueError):
-            problems.append(f"{where}: expected (first_line, last_line, mode)")
-            continue
-        if not all(
-            isinstance(v, int | np.integer) and not isinstance(v, bool) for v in (first, last)
-        ):
-            problems.append(f"{where}: line numbers must be integers")
-            continue
-        if mode not in ARM_MODES:
-            problems.append(f"{where}: mode {mode!r} is not one of {', '.join(ARM_MODES)}")
-        if not 1 <= first <= last <= num_lines:
-            problems.append(f"{where}: needs 1 <= first_line <= last_line <= {num_lines}")
-            continue
-        if first < expected:
-            problems.append(f"{where}: overlaps lines already covered up to {expected - 1}")
-        elif first > expected:
-            problems.append(f"{where}: lines {expected}..{first - 1} are not covered")
-        pwm[first - 1 : last] = mode == "pwm"
-        expected = max(expected, last + 1)
-    if expected <= num_lines:
-        problems.append(f"{arm}: lines {expected}..{num_lines} are not covered")
-    return problems
 
 
 @dataclass(frozen=True, eq=False)

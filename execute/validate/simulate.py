@@ -39,7 +39,8 @@ from daemon.sim.board_trip import TripEvent
 from daemon.sim.grasp_latch import GraspEvent
 from daemon.structs import STATE_DTYPE, new_sample
 from execute.motion.config import MotionConfig
-from execute.play.player import ArmModeSchedule, PlayerOptions, TrajectoryPlayer
+from execute.play.arm_modes import ArmModeSchedule
+from execute.play.player import PlayerOptions, TrajectoryPlayer
 from execute.validate.verdict import Failure, Verdict, VerdictConfig, VerdictMonitor
 from ladders.geometry import LadderGeometry
 from ladders.spec import LadderSpec
