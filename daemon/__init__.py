@@ -1,8 +1,9 @@
 """The daemon side: per-joint control law, the 200 Hz loop, channels and backends.
 
 - here: channel structs (`structs`), latest-value channels (`channels`), the control law
-  (`control_modes`, `joint_control`, `pwm`), the loop (`loop`), joint/sensor tables
-  (`tables`), the state log, and the ``hubo-daemon``, ``hubo-console``, ``hubo-read`` CLIs;
+  (`control_modes`, `joint_control`, `pwm`), the loop (`loop`) and the interface its
+  backends implement (`backend`), joint/sensor tables (`tables`), the state log, and the
+  ``hubo-daemon``, ``hubo-console``, ``hubo-read`` CLIs;
 - `daemon.can`: the CAN protocol, backend and board emulator;
 - `daemon.sim`: the MuJoCo board model and the simulated world (grip, sensors, trips).
 

@@ -11,7 +11,8 @@ from contextlib import contextmanager
 
 import numpy as np
 
-from daemon.loop import DaemonChannels, DaemonLoop, LoopConfig, SensorFrame
+from daemon.backend import SensorFrame
+from daemon.loop import DaemonChannels, DaemonLoop, LoopConfig
 
 
 class PerfectBoards:

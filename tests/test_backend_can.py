@@ -11,10 +11,11 @@ import can
 import numpy as np
 import pytest
 
+from daemon.backend import BoardCommands
 from daemon.can import protocol as cp
 from daemon.can.backend import CanBackend, parse_channels
 from daemon.can.emulator import BoardEmulator
-from daemon.loop import BoardCommands, DaemonChannels, DaemonLoop, LoopConfig
+from daemon.loop import DaemonChannels, DaemonLoop, LoopConfig
 from daemon.structs import REF_DTYPE, BoardCommandType, StatusFlag, new_sample
 from daemon.tables import load_joint_table, load_sensor_table
 from robot.errors import InputError

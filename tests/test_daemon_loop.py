@@ -8,7 +8,8 @@ import time
 import numpy as np
 import pytest
 
-from daemon.loop import BoardCommands, DaemonChannels, DaemonLoop, LoopConfig, SensorFrame
+from daemon.backend import BoardCommands, SensorFrame
+from daemon.loop import DaemonChannels, DaemonLoop, LoopConfig
 from daemon.state_log import LOG_DTYPE, StateLogWriter, read_state_log
 from daemon.structs import (
     BOARD_CMD_DTYPE,

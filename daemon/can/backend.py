@@ -36,9 +36,9 @@ import time
 import can
 import numpy as np
 
+from daemon.backend import BoardCommands, SensorFrame
 from daemon.can import protocol as cp
 from daemon.can.cycle_plan import CyclePlan
-from daemon.loop import BoardCommands, SensorFrame
 from daemon.structs import NUM_FT, NUM_IMU, BoardCommandType, StatusFlag
 from daemon.tables import JointTable, SensorTable, load_joint_table, load_sensor_table
 from robot.constants import GRAVITY_M_S2

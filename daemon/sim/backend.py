@@ -20,8 +20,8 @@ import math
 
 import numpy as np
 
+from daemon.backend import BoardCommands, SensorFrame
 from daemon.joint_control import ControlOutput
-from daemon.loop import BoardCommands, SensorFrame
 from daemon.sim.board_model import TICK_S, BoardModel, BoardModelConfig
 from daemon.structs import BoardCommandType, StatusFlag
 from ladders.spec import LadderSpec

@@ -33,6 +33,9 @@ no back-EMF braking).
 Board trips: `daemon.sim.board_trip` (boards grouped as on the robot; the wrist roll shares
 its board with the fingers, whose grip then lets go). Grip: `daemon.sim.grasp_latch`.
 Sensors: `daemon.sim.sensors`; motor currents and battery power from `robot.motors`.
+
+Size: one class, `BoardModel`, whose tick (actuation, physics, trips, latches, sensors)
+works on one MuJoCo model and data.
 """
 
 from __future__ import annotations

@@ -64,6 +64,9 @@ within (with a reserve) and check-plan checks: radial force 417 N and bending to
 hand, about the palm site, split along and across the rail. ``slip_persistence_s =
 10 ms`` (two ticks) only filters single-step constraint spikes at impacts; it is not a
 tuning knob.
+
+Size: one latch per hand (latch, slip, release on one weld); most of the file is this
+description.
 """
 
 from __future__ import annotations
