@@ -22,14 +22,9 @@ from planner.statics.arm_capacity import (
     gripping_sides,
     gripping_torque_limits,
 )
-from planner.statics.stability import (
-    SupportRegion,
-    TorqueCheck,
-    check_stability,
-    support_region,
-    torque_feasibility,
-    torque_limits_by_joint,
-)
+from planner.statics.com_region import SupportRegion, support_region
+from planner.statics.stability import check_stability
+from planner.statics.torque_lp import TorqueCheck, torque_feasibility, torque_limits_by_joint
 from robot.vocabulary import RejectCause
 
 #: Tolerance on the joint limits [rad] (placo's QP meets them to solver precision).

@@ -20,15 +20,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from planner.contacts import Stance
-
-# support_region and torque_limits_by_joint are imported here only for
-# planner/configuration/validity.py, which imports them from this module; they belong to
-# com_region and torque_lp (or the package, `planner.statics`).
 from planner.statics.com_region import SupportRegion
-from planner.statics.com_region import support_region as support_region
 from planner.statics.config import StabilityConfig
 from planner.statics.torque_lp import TorqueCheck, torque_feasibility
-from planner.statics.torque_lp import torque_limits_by_joint as torque_limits_by_joint
 
 __all__ = ["StabilityReport", "check_stability"]
 
