@@ -27,6 +27,9 @@ hubo-motion-rt and the thesis's operator did (thesis §4.3.4, §6.2):
 
 Its only input is the daemon's state struct (`execute.motion.sensed_state`). It writes
 references, modes and feed-forward, the same things the open-loop player writes.
+
+One module: the steps above share one state machine over the plan's segments (the
+offsets, the pending grasp, the pause) that each tick advances.
 """
 
 from __future__ import annotations
