@@ -24,7 +24,7 @@ demo: install
 	mkdir -p demo-out
 	$(BIN)/python -m ladders show drc --out demo-out
 	$(BIN)/plan-ladder drc --seed 4 -o demo-out/drc.traj.gz --plots demo-out/stances
-	$(BIN)/check-plan demo-out/drc.traj.gz --ladder drc --every 10
+	$(BIN)/check-plan demo-out/drc.traj.gz --ladder drc
 	MUJOCO_GL=egl $(BIN)/validate-plan demo-out/drc.traj.gz --strategy mixed \
 		--json demo-out/drc.result.json --plots demo-out/plots; \
 		status=$$?; [ $$status -le 1 ] || exit $$status; \

@@ -6,6 +6,9 @@ its end under ``mixed`` and ``position`` even after a failure (the figure is the
 simulator's speed, not the verdict; the verdict is printed).
 ``HUBO_BENCH_PLAN=path/to/plan.traj`` (with its ``.plan.json``) times another plan, and
 ``HUBO_BENCH_PLAN=fixture`` the hand-built test fixture (6.2 s of motion + 1 s settle).
+
+The same plan times ``check-plan`` (every line, the default): target ≤ 60 s for a whole
+DRC climb (issue 20), reading the file included.
 """
 
 from __future__ import annotations
@@ -16,6 +19,7 @@ import tempfile
 from pathlib import Path
 
 TARGET_RTF = 10.0
+TARGET_CHECK_PLAN_S = 60.0
 #: The DRC seed of `make demo` (its whole climb, the run a user times first).
 DRC_SEED = 4
 
@@ -52,6 +56,7 @@ def run() -> list[dict]:
         sc = read_sidecar(sidecar_path(plan))
         traj = read_trajectory(plan, sc.rate_hz, sc.robot)
         ladder = sidecar_ladder(sc, str(plan))
+        out.append(_check_plan(plan, sc.line_count))
         for strategy in ("mixed", "position"):
             run_ = simulate(traj, sc, ladder, SimulationOptions(
                 strategy=strategy, record_qpos=False, stop_on_failure=False), sc.robot)
@@ -63,6 +68,23 @@ def run() -> list[dict]:
                         "value": round(rtf, 2), "unit": "x real time",
                         "target": f">= {TARGET_RTF:g}", "ok": rtf >= TARGET_RTF})
     return out
+
+
+def _check_plan(plan: Path, lines: int) -> dict:
+    """``check-plan PLAN`` in-process (its report swallowed): wall time [s]."""
+    import contextlib
+    import io
+    import time
+
+    from planner.verify.cli import main as check_plan
+
+    t0 = time.perf_counter()
+    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+        status = check_plan([str(plan)])
+    wall = time.perf_counter() - t0
+    return {"name": f"check_plan_{plan.stem} ({lines:,} lines, every line; exit {status})",
+            "value": round(wall, 1), "unit": "s", "target": f"<= {TARGET_CHECK_PLAN_S:g}",
+            "ok": wall <= TARGET_CHECK_PLAN_S}
 
 
 if __name__ == "__main__":

@@ -16,8 +16,11 @@ digits (gzip makes it 71 MB), 123 MB rounded, and 39 MB rounded and gzipped.
 from __future__ import annotations
 
 import gzip
+import io
 import math
 import os
+import re
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -188,10 +191,41 @@ def _check_clamp_tolerance(tol_rad: float) -> float:
     return tol
 
 
+#: Any character but digits, signs, points, exponents, spaces, tabs and newlines.
+_NOT_PLAIN = re.compile(r"[^0-9eE+\-. \t\n]")
+
+
+def _parse_plain(text: str, limits, rate_hz: float, check_speed: bool) -> np.ndarray | None:
+    """The whole file read by numpy at once, when it is plainly good: only numbers and
+    blanks, 40 values on every line, none past a limit (nor a step past a speed limit,
+    if checked). None otherwise: `_parse` then reads it line by line and names every
+    problem. A DRC climb of 300,000 lines: 1.5 s instead of 9."""
+    if _NOT_PLAIN.search(text) or max(map(len, text.split("\n"))) > MAX_LINE_CHARS:
+        return None
+    lines = text.count("\n") + (not text.endswith("\n"))
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # numpy warns on a file with no data
+            q = np.loadtxt(io.StringIO(text), comments=None, ndmin=2)
+    except ValueError:
+        return None
+    tol = LIMIT_TOLERANCE_RAD
+    if q.shape != (lines, NUM_JOINTS) or not np.isfinite(q).all() \
+            or (q < limits.lower_rad - tol).any() or (q > limits.upper_rad + tol).any():
+        return None
+    if check_speed and len(q) > 1 and (np.abs(np.diff(q, axis=0)) * rate_hz
+                                       > limits.velocity_max_rad_s + 1e-9).any():
+        return None
+    return q
+
+
 def _parse(text: str, source: str, rate_hz: float, robot: str, check_speed: bool,
            clamp_tol_rad: float) -> tuple[np.ndarray, tuple[ClampedJoint, ...]]:
     """`parse_trajectory`, clamping values within ``clamp_tol_rad`` beyond a limit."""
     limits = joint_limits(robot)
+    plain = _parse_plain(text, limits, rate_hz, check_speed)
+    if plain is not None:  # nothing to report, nothing to clamp
+        return plain, ()
     clamped: dict[int, list[tuple[int, float, float, float]]] = {}
     problems: list[str] = []
     rows: list[np.ndarray] = []

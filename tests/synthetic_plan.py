@@ -53,6 +53,16 @@ def synthetic_plan() -> tuple[ClimbPlanner, SearchResult, np.ndarray]:
     return planner, SearchResult(segments, stance, stats, 0.3), q0
 
 
+def write_synthetic_plan(path):
+    """The synthetic plan written to ``path`` (and its sidecar) as plan-ladder writes it,
+    at 200 Hz, without the clearance metric; returns ``path``."""
+    from planner.output import write_plan
+
+    planner, result, q0 = synthetic_plan()
+    write_plan(result, planner, path, 200.0, q_start=q0, clearance_every=0)
+    return path
+
+
 def use_synthetic_search(monkeypatch) -> SearchResult:
     """Replace `ClimbPlanner.plan` by the synthetic plan (the real search is slow), with its
     progress calls; returns the result it gives."""

@@ -13,9 +13,8 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).parent))
 
-from synthetic_plan import synthetic_plan  # noqa: E402
+from synthetic_plan import write_synthetic_plan  # noqa: E402
 
-from planner.output import write_plan  # noqa: E402
 from planner.verify.check import CHECKS, allowed_contacts  # noqa: E402
 from planner.verify.cli import main  # noqa: E402
 from robot.joints import JOINT_INDEX  # noqa: E402
@@ -25,10 +24,7 @@ from robot.plan_sidecar import HoldRecord, Segment, sidecar_path  # noqa: E402
 
 @pytest.fixture(scope="module")
 def good(tmp_path_factory) -> Path:
-    planner, result, q0 = synthetic_plan()
-    path = tmp_path_factory.mktemp("plan") / "good.traj"
-    write_plan(result, planner, path, 200.0, q_start=q0, clearance_every=0)
-    return path
+    return write_synthetic_plan(tmp_path_factory.mktemp("plan") / "good.traj")
 
 
 def _copy(src: Path, dst: Path) -> Path:
@@ -55,7 +51,7 @@ def test_moved_hold_fails_naming_the_line(good, tmp_path, capsys):
     assert main([str(bad), "--ladder", "drc", "--every", "50"]) == 1
     err = capsys.readouterr().err
     line = int(err.split("holds fails at line ")[1].split(":")[0])
-    assert seg["first_line"] <= line <= seg["last_line"]
+    assert line == seg["first_line"]  # every line of it is as far off: the first is named
     assert "right_foot 5.00 cm from its hold on floor" in err
 
 
@@ -128,6 +124,27 @@ def test_collision_is_reported(good, tmp_path, capsys):
     assert f"collision fails at line {len(q)}" in err
     assert "floor" in err.split("collision fails")[1].splitlines()[0]
     assert f"stability margin fails at line {len(q)}" in err
+
+
+def test_every_line_is_checked_by_default(good, tmp_path, capsys):
+    """One line in the middle of the rise folds the standing leg (the right shin goes into
+    the floor): the default finds it; ``--every 50``, which skips that line's collision
+    and statics, does not. Holds, limits and speed are checked on every line either way."""
+    from robot.trajectory_file import format_trajectory
+
+    bad = _copy(good, tmp_path / "one.traj")
+    q = np.loadtxt(bad)
+    line = 1000  # the rise is lines 806-1174: not on its every-50 grid, not an end
+    q[line - 1, JOINT_INDEX["LHP"]], q[line - 1, JOINT_INDEX["LKN"]] = -1.4, 2.5
+    bad.write_text(format_trajectory(q))
+    assert main([str(bad)]) == 1
+    err = capsys.readouterr().err
+    assert f"collision fails at line {line}: straighten/body:" in err
+    assert f"stability margin fails at line {line}" in err
+    assert main([str(bad), "--every", "50"]) == 1
+    out, err = capsys.readouterr()
+    assert "collision fails" not in err and "stability margin fails" not in err
+    assert f"holds fails at line {line}:" in err  # the right foot leaves its hold
 
 
 def test_a_lone_compliant_hand_is_not_counted_on_for_balance():

@@ -53,6 +53,27 @@ def test_round_trip_is_within_a_nanoradian_then_exact(tmp_path, name):
     assert max(len(v.split(".")[-1]) for v in format_trajectory(q).split()) <= 9
 
 
+@pytest.mark.parametrize("text", ["plain", "tabs and 17 digits", "crlf", "last line bare"])
+def test_a_good_file_reads_the_same_at_once_and_line_by_line(monkeypatch, text):
+    """numpy reads a plainly good file at once; the line-by-line reader (which names
+    problems) gives the same array, bit for bit."""
+    import robot.trajectory_file as tf
+
+    q = _smooth_trajectory(200)
+    body = format_trajectory(q)
+    if text == "tabs and 17 digits":
+        body = "\n".join("\t".join(repr(float(v)) for v in row) for row in q) + "\n"
+    elif text == "crlf":
+        body = body.replace("\n", "\r\n")
+    elif text == "last line bare":
+        body = body.rstrip("\n")
+    at_once = tf.parse_trajectory(body, "x.traj", 25.0)
+    plain = tf._parse_plain(body, joint_limits("drc-hubo"), 25.0, True)
+    assert (plain is None) == (text == "crlf")  # a CR goes line by line
+    monkeypatch.setattr(tf, "_parse_plain", lambda *args: None)
+    assert np.array_equal(at_once, tf.parse_trajectory(body, "x.traj", 25.0))
+
+
 def test_gz_is_the_same_text_compressed_and_deterministic(tmp_path):
     import gzip
 

@@ -31,9 +31,10 @@ its tread (the planner keeps a friction share and a centre-of-pressure margin).
 
 `check_plan` returns, per check, the worst line and whether any line fails.
 
-Size: every check runs in one pass over the lines, on the configuration
-`_Verifier` rebuilds from the sidecar's holds; `check_plan` reads as that pass
-(limits and speed, holds, then the statics of each checked line).
+Size: the checks run in one pass over the lines (`check_plan`), a batch of one segment's
+lines at a time (`planner.verify.line_pass`); this module keeps what the pass shares:
+the results, the contact rules and models, and `_Verifier`, the robot and ladder models
+the lines are checked on.
 """
 
 from __future__ import annotations
@@ -42,6 +43,7 @@ import logging
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from functools import cached_property
 from types import SimpleNamespace
 from typing import TYPE_CHECKING, NamedTuple
 
@@ -73,8 +75,12 @@ LIMIT_TOL_RAD = 1e-9
 #: Clearance (a slow distance query) is measured on every this-many-th line, by check-plan
 #: and for the plan's own clearance metric (planner.output), so the two compare.
 CLEARANCE_EVERY_LINES = 20
-#: check_plan reports its progress every this many lines.
-PROGRESS_EVERY_LINES = 100
+#: Values within this of the worst are equal to it (`CheckResult.worst_line`) [the
+#: check's unit: m, ratio, share]: rounding, and the LPs' vertices within their tolerance.
+WORST_TIE = 1e-9
+#: check_plan checks this many lines of a segment at once, and reports its progress after
+#: each batch.
+BATCH_LINES = 1024
 CHECKS = ("joint limits", "velocity", "holds", "collision", "stability margin",
           "torque ratio", "contact wrench")
 _FRAME = {"left_hand": "L_palm", "right_hand": "R_palm", "left_foot": "L_sole",
@@ -88,7 +94,9 @@ class CheckResult:
     Attributes:
         name: one of `CHECKS`.
         ok: every checked line passed.
-        worst_line: 1-based line with the worst value (0: nothing checked).
+        worst_line: 1-based line with the worst value (0: nothing checked): the first
+            line whose value is within `WORST_TIE` of the worst, so that lines equal but
+            for rounding (a dwell, a grip at its limit) name the first of them.
         value: the worst value, in ``unit``.
         limit: the value it must stay within, in ``unit``.
         unit: unit of ``value`` and ``limit``.
@@ -107,10 +115,11 @@ class CheckResult:
     _worst_key: float = field(default=-math.inf, repr=False)
 
     def offer(self, line: int, key: float, value: float, detail: str, failed: bool) -> None:
-        """Record a line's value; ``key`` orders badness (larger is worse)."""
+        """Record a line's value; ``key`` orders badness (larger is worse). Lines come
+        in order; a later one must be worse by more than `WORST_TIE`."""
         self.failing_lines += int(failed)
         self.ok &= not failed
-        if key > self._worst_key:
+        if key > self._worst_key + WORST_TIE:
             self._worst_key, self.worst_line, self.value, self.detail = key, line, value, detail
 
 
@@ -255,7 +264,35 @@ class _Verifier:
         self.collision = CollisionModel(robot_view, ladder_collision_objects(spec))
         self.torque_max = torque_limits_by_joint(self.params.name)
         self.arm_strategy = arm_strategy
-        self._stances: dict[int, tuple] = {}  # segment index → stance, region, limits
+        self._stances: dict[int, _SegmentStance] = {}  # by segment index
+        self._stances_by_holds: dict[tuple, _SegmentStance] = {}
+        self._regions: dict[tuple, SupportRegion] = {}  # by the holds that balance
+        self._stance_lines: dict[int, object] = {}  # segment index → its torque LP
+
+    @cached_property
+    def kin(self):
+        """The robot's kinematics on batches of lines (`BatchKinematics`)."""
+        from planner.verify.batch_kinematics import BatchKinematics
+
+        return BatchKinematics(self.model)
+
+    @cached_property
+    def collision_lines(self):
+        """The collision checks on batches of lines (`CollisionLines`)."""
+        from planner.verify.collision_lines import CollisionLines
+
+        return CollisionLines(self.collision)
+
+    def stance_lines(self, seg_index: int, seg: Segment):
+        """The torque LP of a segment's stance on batches of lines (`StanceLines`),
+        cached: it carries its basis from batch to batch."""
+        if seg_index not in self._stance_lines:
+            from planner.verify.torque_lines import StanceLines
+
+            held = self.stance(seg_index, seg)
+            self._stance_lines[seg_index] = StanceLines(self.kin, held.stance.holds,
+                                                        held.torque_limits, self.frame_id)
+        return self._stance_lines[seg_index]
 
     # ---------------------------------------------------------------- configuration
     def sole_rotation(self, target: str) -> np.ndarray:
@@ -282,6 +319,39 @@ class _Verifier:
         pin.framesForwardKinematics(self.model, self.data, q)
         return q
 
+    def line_poses(self, columns: np.ndarray, seg: Segment):
+        """`configuration` on a batch of lines: the joint poses in the world, the base
+        placed from a foot in contact, and the lines' pinocchio configurations (built
+        on demand); (None, None) when no foot is in contact.
+
+        Args:
+            columns: (L, 40) the lines [rad].
+            seg: their segment.
+        """
+        from planner.verify.batch_kinematics import PinConfigurations
+
+        ref = next((lb for lb in ("left_foot", "right_foot") if lb in seg.holds), None)
+        if ref is None:
+            return None, None
+        q = np.zeros((len(columns), self.model.nq))
+        have = self.q_index >= 0
+        q[:, self.q_index[have]] = columns[:, have]
+        frame = self.model.frames[self.frame_id[ref]]
+        # The chain from the base to the foot, with the base at the origin, places it.
+        rel = self.kin.joint_poses(q, upto=frame.parentJoint)
+        R_bs, p_bs = rel.frame(frame.parentJoint, frame.placement.rotation,
+                               frame.placement.translation)
+        hold = seg.holds[ref]
+        R_wb = self.sole_rotation(hold.target) @ R_bs.swapaxes(1, 2)
+        p_wb = np.asarray(hold.position_m) - np.einsum("lij,lj->li", R_wb, p_bs)
+        return self.kin.joint_poses(q, R_wb, p_wb), PinConfigurations(q, R_wb, p_wb)
+
+    def frame_positions(self, poses, limb: str) -> np.ndarray:
+        """(L, 3) world position of a limb's frame on a batch of lines [m]."""
+        frame = self.model.frames[self.frame_id[limb]]
+        return poses.frame(frame.parentJoint, frame.placement.rotation,
+                           frame.placement.translation)[1]
+
     # ---------------------------------------------------------------- holds
     def target_distance(self, target: str, p: np.ndarray) -> float:
         """How far a recorded hold position lies from its object [m]; raises
@@ -300,9 +370,6 @@ class _Verifier:
                            max(0.0, abs(d[1]) - s.rung_width_m / 2), d[2]])
         return float(np.linalg.norm(excess))
 
-    def frame_position(self, limb: str) -> np.ndarray:
-        return self.data.oMf[self.frame_id[limb]].translation.copy()
-
     # ---------------------------------------------------------------- stability
     def contact_hold(self, limb: str, record) -> Hold:
         """The contact model of a recorded hold (`contact_hold`)."""
@@ -311,19 +378,34 @@ class _Verifier:
     def stance(self, seg_index: int, seg: Segment) -> _SegmentStance:
         """The stance of a segment, its support region and its joint torque limits [N·m]
         (arms whose hands hold a rail driven as the plan's arm strategy drives them; the
-        planner's capacity model is robot data), cached."""
+        planner's capacity model is robot data), cached: by segment, by holds (segments
+        that share their holds share it) and the region by the holds that balance."""
         if seg_index not in self._stances:
-            from planner.contacts import Stance
-            from planner.statics.com_region import support_region
-
-            stance = Stance(tuple(self.contact_hold(lb, h) for lb, h in sorted(seg.holds.items())))
-            limits = gripping_torque_limits(self.torque_max, gripping_sides(seg.holds),
-                                            self.arm_strategy)
-            balance = balance_stance(stance, self.arm_strategy)
-            self._stances[seg_index] = _SegmentStance(
-                stance, support_region(balance, self.params.total_mass_kg), limits,
-                tuple(sorted(balance.limbs)))
+            key = _holds_key(seg.holds)
+            if key not in self._stances_by_holds:
+                self._stances_by_holds[key] = self._new_stance(seg)
+            self._stances[seg_index] = self._stances_by_holds[key]
         return self._stances[seg_index]
+
+    def _new_stance(self, seg: Segment) -> _SegmentStance:
+        from planner.contacts import Stance
+        from planner.statics.com_region import support_region
+
+        holds = sorted(seg.holds.items())
+        stance = Stance(tuple(self.contact_hold(lb, h) for lb, h in holds))
+        limits = gripping_torque_limits(self.torque_max, gripping_sides(seg.holds),
+                                        self.arm_strategy)
+        balance = balance_stance(stance, self.arm_strategy)
+        limbs = tuple(sorted(balance.limbs))
+        key = _holds_key({lb: h for lb, h in holds if lb in limbs})
+        if key not in self._regions:
+            self._regions[key] = support_region(balance, self.params.total_mass_kg)
+        return _SegmentStance(stance, self._regions[key], limits, limbs)
+
+
+def _holds_key(holds: dict) -> tuple:
+    """A hashable key of a segment's holds (limb, target, position)."""
+    return tuple(sorted((lb, h.target, tuple(h.position_m)) for lb, h in holds.items()))
 
 
 def _segment_of_lines(sidecar: PlanSidecar, where: str) -> np.ndarray:
@@ -395,8 +477,8 @@ def check_plan(traj_rad: np.ndarray, sidecar: PlanSidecar, spec, robot: str | No
             first and last line of every segment); limits and holds are always checked
             on every line.
         where: the plan's name, for messages.
-        progress: called as ``progress(lines_done, lines)`` every `PROGRESS_EVERY_LINES`
-            lines and at the end.
+        progress: called as ``progress(lines_done, lines)`` at the start and after every
+            batch (at most `BATCH_LINES` lines).
 
     Returns:
         One result per check, in `CHECKS` order.
@@ -421,31 +503,18 @@ def check_plan(traj_rad: np.ndarray, sidecar: PlanSidecar, spec, robot: str | No
     res = _new_results()
     _check_limits_and_speed(res, traj_rad, joint_limits(robot), rate_hz)
 
-    # Per line: base from a foot, holds, collisions, stability.
-    prev_key = None
-    prev_out: _Statics | None = None
-    for k in range(n):
-        line = k + 1
-        if progress is not None and k % PROGRESS_EVERY_LINES == 0:
-            progress(k, n)
-        si = int(seg_of[k])
-        seg = segs[si]
-        label = f"{seg.primitive}/{seg.phase}"
-        q = v.configuration(traj_rad[k], seg)
-        if q is None:
-            res["holds"].offer(line, math.inf, math.inf, f"{label}: no foot in contact: the "
-                               "base cannot be placed", True)
-            continue
-        _check_holds(res["holds"], v, line, seg, label)
-        at_end = line in (seg.first_line, seg.last_line)
-        if every > 1 and (line - seg.first_line) % every and not at_end:
-            continue
-        key = (si, traj_rad[k].tobytes())
-        if key != prev_key or prev_out is None:  # else a dwell line: the same as before
-            prev_key, prev_out = key, _statics_at(v, q, segs, si, line)
-        _offer_statics(res, line, label, prev_out, v.stance(si, seg).balance_limbs)
+    # Per batch of lines of one segment: base from a foot, holds, collisions, stability.
+    from planner.verify.line_pass import check_lines
+
     if progress is not None:
-        progress(n, n)
+        progress(0, n)
+    cuts = np.flatnonzero(np.diff(seg_of)) + 1
+    for lo, hi in zip(np.r_[0, cuts], np.r_[cuts, n], strict=True):
+        for a in range(int(lo), int(hi), BATCH_LINES):
+            b = min(int(hi), a + BATCH_LINES)
+            check_lines(res, v, traj_rad, segs, int(seg_of[a]), np.arange(a, b), every)
+            if progress is not None:
+                progress(b, n)
     return [res[c] for c in CHECKS]
 
 
@@ -490,82 +559,3 @@ def _check_limits_and_speed(res: dict[str, CheckResult], traj_rad: np.ndarray, l
                                   bool(ratio[k, j] > 1.0 + 1e-9))
     else:
         res["velocity"].value = 0.0
-
-
-def _check_holds(result: CheckResult, v: _Verifier, line: int, seg: Segment,
-                 label: str) -> None:
-    """Every limb the segment holds: its frame at its hold, and the hold on its object."""
-    hold_err, hold_what = 0.0, ""
-    for limb, h in seg.holds.items():
-        p = np.asarray(h.position_m)
-        d_frame = float(np.linalg.norm(v.frame_position(limb) - p))
-        d_target = v.target_distance(h.target, p)
-        if max(d_frame, d_target) >= hold_err:
-            hold_err = max(d_frame, d_target)
-            hold_what = (f"{label}: {limb} {d_frame * 100:.2f} cm from its hold on "
-                         f"{h.target}, hold {d_target * 100:.2f} cm from {h.target}")
-    result.offer(line, hold_err, hold_err, hold_what, hold_err > HOLD_TOL_M)
-
-
-class _Statics(NamedTuple):
-    """Collision, balance and load figures of one configuration."""
-
-    hit: bool
-    clearance_m: float  # nan when not measured on this line
-    pair: str
-    margin_m: float
-    torque_ratio: float
-    worst_joint: str
-    feasible: bool
-    contact: ContactLoad | None
-
-
-def _statics_at(v: _Verifier, q: np.ndarray, segs: Sequence[Segment], si: int,
-                line: int) -> _Statics:
-    """Collisions (clearance every `CLEARANCE_EVERY_LINES`), the CoM's margin, the torque
-    LP and the contacts' use at ``q``, a line of segment ``si``."""
-    from planner.statics.stability import check_stability
-    from planner.statics.torque_lp import torque_feasibility
-
-    seg = segs[si]
-    frac = (line - seg.first_line) / max(1, seg.last_line - seg.first_line)
-    v.collision.allow(allowed_contacts(segs, si, frac))
-    hit = v.collision.in_collision(q)
-    clear, pair = math.nan, ""
-    if hit or (line - 1) % CLEARANCE_EVERY_LINES == 0:
-        rep = v.collision.report(q)
-        clear, pair = rep.min_distance_m, " – ".join(rep.closest_pair)
-    held = v.stance(si, seg)
-    rep_s = check_stability(v.model, v.data, q, held.stance, held.region, held.torque_limits)
-    tq = rep_s.torque
-    contact = None
-    if tq is not None and tq.feasible:  # the torque LP's own wrenches
-        contact = contact_wrench_utilisation(tq)
-    elif tq is not None:  # the least contact use any share within the joints needs
-        contact = contact_wrench_utilisation(torque_feasibility(
-            v.model, v.data, q, held.stance, held.torque_limits, v.frame_id,
-            objective="contact"))
-    return _Statics(hit, clear, pair, rep_s.margin_m,
-                    math.inf if tq is None else tq.max_ratio,
-                    "" if tq is None else tq.worst_joint, tq is not None and tq.feasible,
-                    contact)
-
-
-def _offer_statics(res: dict[str, CheckResult], line: int, label: str, out: _Statics,
-                   balance: Sequence[str]) -> None:
-    if out.hit or not math.isnan(out.clearance_m):
-        d = out.clearance_m if not math.isnan(out.clearance_m) else 0.0
-        res["collision"].offer(line, -d + (1.0 if out.hit else 0.0), d,
-                               f"{label}: {out.pair or 'in collision'}", out.hit)
-    margin = out.margin_m
-    res["stability margin"].offer(line, -margin, margin,
-                                  f"{label}: CoM margin {margin * 100:.1f} cm in the "
-                                  f"support region of {', '.join(balance)}", margin < 0.0)
-    if margin >= 0.0:
-        res["torque ratio"].offer(line, out.torque_ratio, out.torque_ratio,
-                                  f"{label}: worst joint {out.worst_joint}", not out.feasible)
-    if out.contact is not None:
-        res["contact wrench"].offer(line, out.contact.value, out.contact.value,
-                                    f"{label}: {out.contact.detail}",
-                                    out.contact.value > 1.0 + 1e-6)
-
