@@ -139,7 +139,7 @@ def _write_plots(args: argparse.Namespace, result, planner, spec, out, err, on_o
     on_output("snapshot strip", 0, 1)
     try:
         strip = write_plan_strip(out.timed.configs, planner.kin, spec,
-                                 Path(args.plots) / "snapshots.png")
+                                 Path(args.plots) / "snapshots.png", sidecar=out.sidecar)
         log.info("wrote %s", strip)
     except RenderingUnavailable as exc:
         err.print(f"plan-ladder: no snapshot strip: {exc}", markup=False)

@@ -99,7 +99,8 @@ def test_happy_path_writes_checkable_files_and_plots(fake_search, tmp_path, caps
         from ladders.render import SNAPSHOT_SIZE
 
         image = iio.imread(strip)
-        assert image.shape[:2] == (SNAPSHOT_SIZE[1], 6 * SNAPSHOT_SIZE[0])
+        assert image.shape[1] == 6 * SNAPSHOT_SIZE[0]  # six frames, captioned below:
+        assert SNAPSHOT_SIZE[1] < image.shape[0] < SNAPSHOT_SIZE[1] + 80
         assert image.std() > 10  # a scene, not a blank frame
     else:
         assert "no snapshot strip" in cap.err
