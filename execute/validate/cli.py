@@ -3,7 +3,7 @@
     validate-plan PLAN.traj [--ladder L] [--strategy mixed|position|pwm] [--battery V]
                   [--placement-error dx,dy,dyaw] [--json R.json] [--video V.mp4]
                   [--plots DIR] [--robot R] [--open-loop] [--max-reach-correction M]
-                  [--grasp-retries N] [--holding-arm-stiffness S]
+                  [--grasp-retries N] [--holding-arm-stiffness S] [--record R.rrd]
 
 Reads ``PLAN.traj`` and its sidecar ``PLAN.plan.json`` (rate, holds, arm schedule,
 ladder), runs `execute.validate.simulate.simulate`, prints the verdict and the metrics, and
@@ -56,6 +56,10 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--json", metavar="R.json", help="write the result here")
     p.add_argument("--video", metavar="V.mp4", help="write an MP4 (needs EGL)")
     p.add_argument("--plots", metavar="DIR", help="write tracking plots and a snapshot strip")
+    p.add_argument("--record", metavar="R.rrd",
+                   help="write a Rerun recording of the run (the simulated robot beside the "
+                        "plan's ghost, events, joint series): rerun R.rrd opens it "
+                        "(docs/viewer.md)")
     p.add_argument("--robot", default=None, help="robot (default: the sidecar's)")
     p.add_argument("-v", "--verbose", action="store_true", help="log events as they happen")
     return p
@@ -192,6 +196,10 @@ def _run(args: argparse.Namespace) -> int:
     from robot.trajectory_file import read_trajectory
 
     plan = Path(args.plan)
+    if args.record:
+        from execute.view.output import check_output
+
+        check_output(args.record)
     side = sidecar_path(plan)
     if not side.exists():
         raise InputError(f"{side}: no plan sidecar next to {plan}; validate-plan needs the "
@@ -223,6 +231,10 @@ def _run(args: argparse.Namespace) -> int:
           f"time")
     if args.json:
         Path(args.json).write_text(json.dumps(result, indent=1))
+    if args.record:
+        from execute.view.run_recording import write_run_recording
+
+        print(f"wrote {write_run_recording(run, traj, ladder, args.record)}")
     if args.plots or args.video:
         from execute.validate.artifacts import (
             RenderingUnavailable,
