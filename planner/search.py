@@ -88,11 +88,10 @@ class PlannerConfig:
     max_backtracks: int = 30
     time_limit_s: float = 600.0
     min_margin_m: float = 0.0
-    # Thighs and shins keep this far from the ladder [m]. A leg bearing the robot sags:
-    # its position loops reach their torque limit at 0.02 rad of error
-    # (robot.mjcf.POSITION_SATURATION_ERROR_RAD), 7 mm at a knee 0.33 m from the hip, and
-    # a shin planned 4 mm from the rung above pressed on it with 111 N in MuJoCo.
-    leg_clearance_m: float = 0.01
+    # Thighs and shins keep this far from the ladder [m]: what playback leaves between a
+    # stance leg and the plan, a foot up to 1.5 cm forward on its rung and a loaded leg
+    # sagging at its position loops' torque limit (docs/decisions/leg-clearance.md).
+    leg_clearance_m: float = 0.025
     arm_strategy: str = DEFAULT_ARM_STRATEGY  # how gripping arms are driven (arm_capacity)
     # Largest planned joint torque / limit, compliant arm joints included (their limit is
     # their PWM clamp). The reserve the legs need is `position_torque_share`'s.
