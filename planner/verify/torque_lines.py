@@ -39,6 +39,7 @@ import numpy as np
 from ladders.contact_model import HandLimits
 from planner.statics.config import StabilityConfig, StabilityError, default_config
 from planner.statics.contact_wrenches import cone_edges_cached, grip_rows, split_wrench_basis
+from planner.statics.highs_lp import dense_lp, quiet_highs
 from planner.statics.torque_lp import GRIP_LOAD_COST
 from planner.verify.batch_kinematics import BatchKinematics, JointPoses
 from robot.errors import HuboLadderError
@@ -374,21 +375,8 @@ class StanceLines:
         """One line with HiGHS, warm-started from the last basis; keeps the new one."""
         import highspy
 
-        h = _highs()
-        inf = highspy.kHighsInf
-        lp = highspy.HighsLp()
-        lp.num_col_, lp.num_row_ = A.shape[1], A.shape[0]
-        lp.col_cost_ = self.cost
-        lp.col_lower_ = np.zeros(A.shape[1])
-        lp.col_upper_ = np.where(np.isinf(self.upper), inf, self.upper)
-        lp.row_lower_ = np.where(np.isinf(lower), -inf, lower)
-        lp.row_upper_ = upper
-        lp.a_matrix_.format_ = highspy.MatrixFormat.kRowwise
-        rows, cols = np.nonzero(A)
-        lp.a_matrix_.start_ = np.concatenate([[0], np.cumsum(np.count_nonzero(A, axis=1))])
-        lp.a_matrix_.index_ = cols
-        lp.a_matrix_.value_ = A[rows, cols]
-        h.passModel(lp)
+        h = quiet_highs()
+        h.passModel(dense_lp(self.cost, A, lower, upper, self.upper))
         if self._basis is not None:
             h.setBasis(self._basis.highs)
         h.run()
@@ -405,18 +393,3 @@ class StanceLines:
         rs = np.array([int(s) for s in b.row_status])
         self._basis = _Basis(cs, rs, b, self._rows_of(cs, rs))
         return "optimal", np.array(h.getSolution().col_value)
-
-
-_HIGHS = None
-
-
-def _highs():
-    """One HiGHS instance per process, quiet, presolve off (as `planner.statics.highs_lp`)."""
-    import highspy
-
-    global _HIGHS
-    if _HIGHS is None:
-        _HIGHS = highspy.Highs()
-        _HIGHS.setOptionValue("output_flag", False)
-        _HIGHS.setOptionValue("presolve", "off")
-    return _HIGHS
