@@ -29,6 +29,7 @@ from execute.view.cli import main as view_main  # noqa: E402
 from execute.view.plan_poses import PlanKinematics  # noqa: E402
 from execute.view.run_recording import peak_samples  # noqa: E402
 from execute.view.scene_meshes import body_meshes  # noqa: E402
+from execute.view.viewer import failure_time  # noqa: E402
 from ladders.loader import sidecar_ladder  # noqa: E402
 from robot.plan_sidecar import read_sidecar, sidecar_path  # noqa: E402
 from robot.trajectory_file import read_trajectory  # noqa: E402
@@ -167,6 +168,8 @@ def test_validate_plan_records_a_run_with_its_grasps(plan, tmp_path):
     assert len(rec["/events/segment"].texts) == len(sidecar.segments)
     assert "Scalars:scalars" in rec["/sim/tracking_error_rad/LSP"].columns
     assert "Scalars:scalars" in rec["/sim/torque_nm/LKN"].columns
+    assert "Scalars:scalars" in rec["/sim/fingers/tracking_error_rad/LF1"].columns
+    assert "/sim/tracking_error_rad/LF1" not in rec
     assert "Arrows3D:vectors" in rec["/world/sim/grip_forces/left"].columns
     assert max(rec["/world/sim/robot/pelvis"].times_s) >= (len(traj) - 1) / sidecar.rate_hz
 
@@ -183,6 +186,7 @@ def test_a_failed_run_opens_at_its_failure(plan, tmp_path):
     assert rec["/events/failure"].times_s == [pytest.approx(failure_s)]
     assert "grasp_not_latched" in rec["/events/failure"].texts[0]
     assert all("missed" in t for t in rec["/events/grasp"].texts)
+    assert failure_time(out) == pytest.approx(failure_s)
     panel = time_panel(out)
     assert panel["timeline"] == ["time"]
     selection = panel["time_selection"]
@@ -204,7 +208,9 @@ def test_hubo_view_of_a_result_puts_its_failure_on_the_plan(plan, tmp_path):
     rec = read_recording(out)
     assert rec["/events/failure"].times_s == [pytest.approx(59 / sidecar.rate_hz)]
     assert rec["/events/motion"].times_s == [pytest.approx(39 / sidecar.rate_hz)]
-    assert "Transform3D:translation" in rec["/world/plan/robot/pelvis"].columns
+    # the plan as far as the run got: it ends 0.5 s past the failure, where a viewer opens
+    end, dt = max(rec["/world/plan/robot/pelvis"].times_s), 1 / sidecar.rate_hz
+    assert 59 * dt + 0.5 - dt <= end <= 59 * dt + 0.5
     assert time_panel(out)["time_selection"]["max"] * 1e-9 == \
         pytest.approx(59 / sidecar.rate_hz + 0.5)
 
@@ -239,11 +245,34 @@ def test_bad_inputs_exit_2_naming_the_file(plan, tmp_path, capsys):
         [str(path), "-o", str(tmp_path / "x.txt")], capsys)
     assert "--display-hz 0" in _bad([str(path), "--display-hz", "0"], capsys)
     assert "no folder" in _bad([str(path), "-o", str(tmp_path / "a" / "b.rrd")], capsys)
+    recording = tmp_path / "run.rrd"
+    recording.write_bytes(b"")
+    assert "opened with --open or --screenshot" in _bad([str(recording)], capsys)
+    assert "--serve is its own viewer" in _bad([str(path), "--serve", "--open"], capsys)
+    assert "--at -1" in _bad([str(recording), "--open", "--at", "-1"], capsys)
+    assert "a screenshot is a .png" in _bad([str(recording), "--screenshot", "x.jpg"], capsys)
 
 
 def test_validate_plan_refuses_a_bad_record_path_before_simulating(plan, tmp_path, capsys):
     err = _bad([str(plan[0]), "--record", str(tmp_path / "run.mp4")], capsys, validate_main)
     assert "run.mp4: a recording is written as a .rrd file" in err
+
+
+@pytest.mark.skipif(not list(Path("/usr/share/vulkan/icd.d").glob("*.json")),
+                    reason="no Vulkan driver for a headless viewer (Debian: "
+                           "mesa-vulkan-drivers)")
+def test_a_headless_viewer_shows_the_plan_recording(plan_recording, tmp_path, capsys):
+    """Rerun's own viewer, headless, opens the file at 3 s and takes a screenshot: the
+    picture is the viewer's layout with the 3D view drawn (many colours, not a blank)."""
+    from PIL import Image
+
+    out, _ = plan_recording
+    shot = tmp_path / "plan.png"
+    assert view_main([str(out), "--screenshot", str(shot), "--at", "3"]) == 0
+    assert "at t = 3 s" in capsys.readouterr().out
+    image = Image.open(shot).convert("RGB")
+    assert image.width >= 800 and image.height >= 600
+    assert len(image.getcolors(maxcolors=1 << 20) or ()) > 500
 
 
 def test_importing_the_viewer_loads_neither_rerun_nor_mujoco():

@@ -1,6 +1,7 @@
 """``hubo-view``: a plan, or a validate-plan result, in 3D as a Rerun recording.
 
-    hubo-view PLAN.traj[.gz] | RESULT.json [-o OUT.rrd | --serve [--web-port P]]
+    hubo-view PLAN.traj[.gz] | RESULT.json | RUN.rrd [-o OUT.rrd | --serve [--web-port P]]
+              [--open] [--screenshot PNG] [--at S]
               [--display-hz HZ] [--force-every S] [--no-statics] [-v]
 
 Writes a recording file (default: beside the input, ``PLAN.plan.rrd`` or
@@ -8,6 +9,10 @@ Writes a recording file (default: beside the input, ``PLAN.plan.rrd`` or
 machine without a display ``rerun --serve-web OUT.rrd`` and a browser. ``--serve`` serves
 the web viewer from this process instead. A simulated run's own recording (the robot as
 simulated, beside the plan's ghost) is written by ``validate-plan --record R.rrd``.
+
+``--open`` shows the recording (written, or given as RUN.rrd) in Rerun's viewer with the
+time cursor at ``--at S``, by default at the failure of a failed run; ``--screenshot``
+saves that view as a PNG from a headless viewer (`execute.view.viewer`).
 
 Exit codes: 0 written, 2 bad input (the message names the file and what is wrong).
 """
@@ -35,7 +40,8 @@ FORCE_EVERY_RANGE_S = (0.005, 60.0)
 def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="hubo-view", description=__doc__.split("\n\n")[0])
     p.add_argument("input", help="a plan (PLAN.traj or PLAN.traj.gz, its PLAN.plan.json "
-                                 "beside it) or a validate-plan result (RESULT.json)")
+                                 "beside it), a validate-plan result (RESULT.json) or a "
+                                 "recording (RUN.rrd) to --open")
     p.add_argument("-o", "--output", metavar="OUT.rrd",
                    help="the recording to write (default: beside the input)")
     p.add_argument("--serve", action="store_true",
@@ -43,6 +49,15 @@ def _parser() -> argparse.ArgumentParser:
                         "file (until Ctrl-C)")
     p.add_argument("--web-port", type=int, default=None, metavar="P",
                    help="the web viewer's HTTP port with --serve (default 9090)")
+    p.add_argument("--open", action="store_true",
+                   help="show the recording in Rerun's viewer, the cursor at --at (needs a "
+                        "display)")
+    p.add_argument("--screenshot", metavar="PNG",
+                   help="save Rerun's view of the recording at --at as a PNG (a headless "
+                        "viewer: needs a Vulkan driver)")
+    p.add_argument("--at", type=float, default=None, metavar="S",
+                   help="with --open or --screenshot: the time [s] to show (default: a "
+                        "failed run's failure, else 0)")
     p.add_argument("--display-hz", type=float, default=20.0, metavar="HZ",
                    help="robot poses drawn per second of plan time (default 20; the data "
                         "is not thinned)")
@@ -60,10 +75,13 @@ def _kind(path: Path) -> str:
     name = path.name
     if name.endswith((".traj", ".traj.gz")):
         return "plan"
+    if name.endswith(".rrd"):
+        return "recording"
     if name.endswith(".json") and not name.endswith(".plan.json"):
         return "result"
     raise InputError(f"{path}: hubo-view reads a plan (PLAN.traj or PLAN.traj.gz, with its "
-                     "PLAN.plan.json beside it) or a validate-plan result (RESULT.json)")
+                     "PLAN.plan.json beside it), a validate-plan result (RESULT.json) or a "
+                     "recording (RUN.rrd)")
 
 
 def default_output(path: Path) -> Path:
@@ -92,18 +110,31 @@ def _layers(args: argparse.Namespace):
                       force_every_s=every)
 
 
-def _run(args: argparse.Namespace) -> int:
-    source = Path(args.input)
-    kind = _kind(source)
-    if not source.is_file():
-        raise InputError(f"{source}: no such file")
-    if args.serve and args.output:
-        raise InputError("-o and --serve: choose one (a file, or a served viewer)")
-    layers = _layers(args)
-    start = time.perf_counter()
+def _check_viewing(args: argparse.Namespace, kind: str) -> None:
+    """The options that show a recording: consistent, and in range."""
+    if args.serve and (args.output or args.open or args.screenshot):
+        raise InputError("--serve is its own viewer: leave out -o, --open and --screenshot")
+    if kind == "recording" and not (args.open or args.screenshot):
+        raise InputError(f"{args.input}: a recording is opened with --open or "
+                         "--screenshot PNG (or: rerun FILE)")
+    if kind == "recording" and args.output:
+        raise InputError(f"{args.input}: a recording is already written; leave out -o")
+    if args.at is not None and not 0.0 <= args.at < float("inf"):
+        raise InputError(f"--at {args.at:g}: a time in seconds, 0 or more")
+    if args.screenshot:
+        shot = Path(args.screenshot)
+        if shot.suffix != ".png" or not shot.parent.is_dir():
+            raise InputError(f"{shot}: a screenshot is a .png file in a folder that exists")
+
+
+def _write(args: argparse.Namespace, source: Path, kind: str) -> Path | None:
+    """Log the input to its recording (a file, or the served viewer); the file."""
     from execute.view import output
 
+    layers = _layers(args)
+    start = time.perf_counter()
     output.require_rerun()
+    out = None
     if args.serve:
         rec, address = output.serve(args.web_port or output.WEB_PORT)
     else:
@@ -119,17 +150,37 @@ def _run(args: argparse.Namespace) -> int:
         record_result(rec, source, layers)
     rec.flush()
     took = time.perf_counter() - start
-    if not args.serve:
-        size = out.stat().st_size / 1e6
-        print(f"wrote {out} ({size:.1f} MB) in {took:.1f} s; open it with: rerun {out}  "
-              f"(no display: rerun --serve-web {out}, then a browser)")
-        return 0
+    if out is not None:
+        print(f"wrote {out} ({out.stat().st_size / 1e6:.1f} MB) in {took:.1f} s; open it "
+              f"with: rerun {out}  (no display: rerun --serve-web {out}, then a browser)")
+        return out
     print(f"serving the recording at {address} (logged in {took:.1f} s); Ctrl-C stops")
     try:
         while True:
             time.sleep(1.0)
     except KeyboardInterrupt:
+        return None
+
+
+def _run(args: argparse.Namespace) -> int:
+    source = Path(args.input)
+    kind = _kind(source)
+    if not source.is_file():
+        raise InputError(f"{source}: no such file")
+    _check_viewing(args, kind)
+    out = source if kind == "recording" else _write(args, source, kind)
+    if out is None or not (args.open or args.screenshot):
         return 0
+    from execute.view.viewer import failure_time, open_in_viewer
+
+    at = args.at if args.at is not None else failure_time(out)
+    if args.screenshot:
+        open_in_viewer(out, 0.0 if at is None else at, args.screenshot)
+        print(f"wrote {args.screenshot}: Rerun's view of {out} at t = {at or 0.0:g} s")
+    if args.open:
+        open_in_viewer(out, at)
+        print(f"opened {out} in Rerun's viewer" + ("" if at is None else f" at t = {at:g} s"))
+    return 0
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -2,9 +2,12 @@
 
 A Rerun blueprint (sent with the recording) lays out a 3D view of ``/world``, the text
 events, and one plot per time series group; the time panel is on the ``time`` timeline
-at real speed. A run that failed opens with the seconds before the failure selected and
-playing in a loop (Rerun's blueprint has no "current time", so a looped selection is how
-a recording says where to look).
+at real speed.
+
+Rerun's blueprint has no "current time": a viewer that opens a file follows it to its
+last time. A failed run's recording ends at its failure (`execute.view.run_recording`,
+`execute.view.result_view`), so it opens there; the blueprint also selects the seconds
+before the failure, and play loops over them.
 """
 
 from __future__ import annotations
@@ -16,7 +19,7 @@ from rerun.encodings import AbsoluteTimeRange, TimeInt
 
 from execute.view.recording import TIMELINE
 
-__all__ = ["BEFORE_FAILURE_S", "blueprint"]
+__all__ = ["AFTER_FAILURE_S", "BEFORE_FAILURE_S", "blueprint"]
 
 #: A failed run opens looping over this long before its failure [s] ...
 BEFORE_FAILURE_S = 7.0
@@ -37,8 +40,7 @@ def blueprint(series: Sequence[tuple[str, str]], failure_s: float | None = None
     panel = rrb.TimePanel(timeline=TIMELINE, playback_speed=1.0)
     if failure_s is not None:
         lo = max(0.0, failure_s - BEFORE_FAILURE_S)
-        panel = rrb.TimePanel(timeline=TIMELINE, playback_speed=1.0, play_state="playing",
-                              loop_mode="selection",
+        panel = rrb.TimePanel(timeline=TIMELINE, playback_speed=1.0, loop_mode="selection",
                               time_selection=AbsoluteTimeRange(
                                   TimeInt(seconds=lo),
                                   TimeInt(seconds=failure_s + AFTER_FAILURE_S)))

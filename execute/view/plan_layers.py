@@ -21,7 +21,7 @@ from execute.view.plan_statics import (
     MAX_FORCE_LINES,
     force_rows,
     hold_forces,
-    support_polygons,
+    support_polygon,
 )
 from execute.view.recording import (
     TIMELINE,
@@ -100,7 +100,6 @@ def log_plan(rec: rr.RecordingStream, kin: PlanKinematics, rows: np.ndarray,
     if layers.statics:
         log_scalars(rec, "plan/stability_margin_cm", times_s, 100 * poses.margin_m,
                     "CoM inside its support region [cm]")
-    polygons = support_polygons(kin) if layers.statics else None
     for si, seg in enumerate(kin.sidecar.segments):
         t = time_of_row(seg.first_line - 1)
         if t is None:
@@ -111,8 +110,8 @@ def log_plan(rec: rr.RecordingStream, kin: PlanKinematics, rows: np.ndarray,
             [seg.holds[limb].position_m for limb in limbs], radii=0.03,
             colors=[LIMB_RGB[Limb(limb)] for limb in limbs],
             labels=[f"{limb.replace('_', ' ')}: {seg.holds[limb].target}" for limb in limbs]))
-        if polygons is not None:
-            poly = polygons[si]
+        if layers.statics:
+            poly = support_polygon(kin, si)
             rec.log(f"{root}/support_region", rr.LineStrips3D(
                 [poly.vertices_m], colors=[REGION_RGB], radii=0.004,
                 labels=[f"support region of {', '.join(poly.limbs)}"]))
@@ -126,10 +125,8 @@ def _log_hold_forces(rec: rr.RecordingStream, kin: PlanKinematics, root: str,
     rows = force_rows(kin.sidecar.line_count, kin.sidecar.rate_hz, layers.force_every_s,
                       layers.max_force_lines)
     times, ratios = [], []
-    for f in hold_forces(kin, rows):
+    for f in hold_forces(kin, [row for row in rows if time_of_row(int(row)) is not None]):
         t = time_of_row(f.row)
-        if t is None:
-            continue
         times.append(t)
         ratios.append(f.max_ratio if np.isfinite(f.max_ratio) else np.nan)
         rec.set_time(TIMELINE, duration=t)

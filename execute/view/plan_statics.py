@@ -18,7 +18,7 @@ import numpy as np
 from execute.view.plan_poses import PlanKinematics
 
 __all__ = ["FORCE_EVERY_S", "HoldForces", "MAX_FORCE_LINES", "SupportPolygon",
-           "force_rows", "hold_forces", "support_polygons"]
+           "force_rows", "hold_forces", "support_polygon"]
 
 #: Planned hold forces are computed on a line every this long [s] ...
 FORCE_EVERY_S = 0.5
@@ -59,19 +59,17 @@ class HoldForces:
     max_ratio: float
 
 
-def support_polygons(kin: PlanKinematics) -> list[SupportPolygon]:
-    """Each segment's support region (`PlanKinematics.region`), at the mean height of
+def support_polygon(kin: PlanKinematics, si: int) -> SupportPolygon:
+    """Segment ``si``'s support region (`PlanKinematics.region`), at the mean height of
     the segment's held feet (the floor if none)."""
-    out = []
-    for si, seg in enumerate(kin.sidecar.segments):
-        held = kin.verifier.stance(si, seg)
-        feet = [h.position_m[2] for limb, h in seg.holds.items() if limb.endswith("_foot")]
-        z = float(np.mean(feet)) if feet else 0.0
-        v = held.region.vertices
-        closed = np.vstack([v, v[:1]]) if len(v) else np.zeros((0, 2))
-        out.append(SupportPolygon(si, np.column_stack([closed, np.full(len(closed), z)]),
-                                  held.balance_limbs))
-    return out
+    seg = kin.sidecar.segments[si]
+    held = kin.verifier.stance(si, seg)
+    feet = [h.position_m[2] for limb, h in seg.holds.items() if limb.endswith("_foot")]
+    z = float(np.mean(feet)) if feet else 0.0
+    v = held.region.vertices
+    closed = np.vstack([v, v[:1]]) if len(v) else np.zeros((0, 2))
+    return SupportPolygon(si, np.column_stack([closed, np.full(len(closed), z)]),
+                          held.balance_limbs)
 
 
 def force_rows(line_count: int, rate_hz: float, every_s: float = FORCE_EVERY_S,

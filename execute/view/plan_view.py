@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import rerun as rr
 
-from execute.view.layout import blueprint
+from execute.view.layout import AFTER_FAILURE_S, blueprint
 from execute.view.plan_layers import PlanLayers, log_plan
 from execute.view.plan_poses import PlanKinematics
 from execute.view.recording import log_static_bodies
@@ -74,11 +74,18 @@ def display_rows(line_count: int, step: int) -> np.ndarray:
 
 def record_plan(rec: rr.RecordingStream, plan: Plan, layers: PlanLayers,
                 failure_s: float | None = None) -> None:
-    """Log a plan: the scene, the robot and the plan's layers, and the layout (opening
-    at ``failure_s`` [s of plan time], if given)."""
+    """Log a plan: the scene, the robot and the plan's layers, and the layout.
+
+    With ``failure_s`` [s of plan time], the plan is drawn up to `AFTER_FAILURE_S` past
+    it, so that the recording opens at the failure (`execute.view.layout`)."""
     rate = plan.sidecar.rate_hz
     kin = PlanKinematics(plan.trajectory_rad, plan.sidecar, plan.ladder, str(plan.path))
     log_static_bodies(rec, "world", kin.model, body_meshes(kin.model))
     rows = display_rows(plan.sidecar.line_count, round(layers.display_every_s * rate))
-    log_plan(rec, kin, rows, rows / rate, lambda row: row / rate, layers)
+    last = plan.sidecar.line_count - 1
+    if failure_s is not None:
+        last = min(last, int((failure_s + AFTER_FAILURE_S) * rate))
+        rows = np.append(rows[rows < last], last)
+    log_plan(rec, kin, rows, rows / rate, lambda row: row / rate if row <= last else None,
+             layers)
     rec.send_blueprint(blueprint(PLAN_SERIES if layers.statics else (), failure_s))

@@ -10,7 +10,8 @@ The timeline is the simulated time. It holds:
 - the grips' loads as arrows at the palms (the latch's load history, every 0.1 s while
   latched), and the simulated CoM;
 - events: grasps, board trips, the motion layer's corrections, the failure;
-- per joint, the tracking error (pos − ref) and the torque, as time series.
+- per joint, the tracking error (pos − ref) and the torque, as time series (the
+  fingers' under ``sim/fingers``).
 
 Display thins the 200 Hz log to `DISPLAY_EVERY_S` for the 3D poses; the series keep, in
 each display interval, the sample of largest magnitude, so no spike is lost.
@@ -39,7 +40,7 @@ from execute.view.recording import (
     robot_bodies,
 )
 from execute.view.scene_meshes import body_meshes
-from robot.joints import JOINT_NAMES
+from robot.joints import FINGER_JOINTS, JOINT_NAMES
 
 __all__ = ["GHOST_RGBA", "RUN_SERIES", "peak_samples", "record_run", "write_run_recording"]
 
@@ -49,8 +50,8 @@ SIM_COM_RGB = (20, 20, 20)
 #: Grip loads are drawn this long per newton [m/N].
 GRIP_M_PER_N = 0.002
 #: The plots of a run's recording: (entity, title).
-RUN_SERIES = (("/sim/tracking_error_rad", "tracking error pos − ref [rad]"),
-              ("/sim/torque_nm", "joint torque [N·m]"),
+RUN_SERIES = (("/sim/tracking_error_rad", "tracking error pos − ref [rad] (fingers apart)"),
+              ("/sim/torque_nm", "joint torque [N·m] (fingers apart)"),
               ("/plan/stability_margin_cm", "plan: CoM margin in its support region [cm]"))
 
 
@@ -118,14 +119,18 @@ def _log_events(rec: rr.RecordingStream, run) -> None:
 
 
 def _log_series(rec: rr.RecordingStream, run, step: int) -> None:
-    """Per joint, the tracking error and the torque, peak-preserving per display step."""
+    """Per joint, the tracking error and the torque, peak-preserving per display step;
+    the fingers apart (``sim/fingers/...``: a finger closed on a rail stays a radian
+    short of its reference, which would flatten the other joints' plots)."""
     lg = run.log
     times = lg.time_s[::step]
     err = peak_samples(lg.pos_rad - lg.ref_rad, step)
     tau = peak_samples(lg.torque_nm, step)
+    fingers = {n for hand in FINGER_JOINTS.values() for n in hand}
     for j, name in enumerate(JOINT_NAMES):
-        log_scalars(rec, f"sim/tracking_error_rad/{name}", times, err[:, j], name)
-        log_scalars(rec, f"sim/torque_nm/{name}", times, tau[:, j], name)
+        group = "sim/fingers" if name in fingers else "sim"
+        log_scalars(rec, f"{group}/tracking_error_rad/{name}", times, err[:, j], name)
+        log_scalars(rec, f"{group}/torque_nm/{name}", times, tau[:, j], name)
 
 
 def record_run(rec: rr.RecordingStream, run, trajectory_rad: np.ndarray, ladder,
