@@ -7,6 +7,7 @@
 - `recording`, `plan_layers`, `layout`, `output`: what goes in a recording, how it
   opens, where it goes;
 - `plan_view`, `result_view`, `run_recording`: a plan, a result JSON, a simulated run;
+- `viewer`: Rerun's viewer on a recording at a given time (``--open``, ``--screenshot``);
 - `cli`: the ``hubo-view`` command.
 
 Re-exported lazily: importing the package loads neither Rerun nor MuJoCo.
@@ -22,6 +23,7 @@ _EXPORTS = {
     "record_plan": "plan_view",
     "record_result": "result_view",
     "record_run": "run_recording",
+    "open_in_viewer": "viewer",
     "write_run_recording": "run_recording",
 }
 

@@ -14,6 +14,7 @@ from __future__ import annotations
 import importlib.util
 from pathlib import Path
 from typing import TYPE_CHECKING
+from urllib.parse import quote
 
 from robot.errors import HuboLadderError, InputError
 
@@ -73,4 +74,4 @@ def serve(web_port: int = WEB_PORT) -> tuple[rr.RecordingStream, str]:
     rec = _stream()
     grpc = rec.serve_grpc()
     rr.serve_web_viewer(web_port=web_port, open_browser=False, connect_to=grpc)
-    return rec, f"http://localhost:{web_port}/?url={grpc}"
+    return rec, f"http://localhost:{web_port}/?url={quote(grpc, safe='')}"
