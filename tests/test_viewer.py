@@ -158,6 +158,10 @@ def test_validate_plan_records_a_run_with_its_grasps(plan, tmp_path):
     for body in ("pelvis", "L_hand", "R_foot"):
         assert "Transform3D:translation" in rec[f"/world/sim/robot/{body}"].columns
         assert "Transform3D:translation" in rec[f"/world/plan/robot/{body}"].columns
+        # the plan is a translucent ghost: one colour with alpha (Rerun blends a mesh's
+        # albedo factor, not its vertex colours); the simulated robot has the geoms' colours
+        assert "Mesh3D:albedo_factor" in rec[f"/world/plan/robot/{body}"].columns
+        assert "Mesh3D:vertex_colors" in rec[f"/world/sim/robot/{body}"].columns
     grasps = rec["/events/grasp"]
     assert len(grasps.texts) == 2 and all("latched" in t for t in grasps.texts)
     # the grasp events sit at the simulated times the result reports

@@ -62,15 +62,17 @@ def log_robot(rec: rr.RecordingStream, root: str, meshes: Sequence[BodyMesh],
         meshes: the robot's bodies (`robot_bodies`).
         times_s: (K,) the poses' times [s].
         body_pos_m, body_quat_xyzw: (K, nbody, 3) and (K, nbody, 4), indexed by body id.
-        tint_rgba: one colour for the whole robot (a ghost), else the geoms' colours.
+        tint_rgba: one colour for the whole robot (a ghost: its alpha makes it
+            translucent, which Rerun draws for a mesh's albedo factor, not for its
+            vertex colours), else the geoms' colours.
     """
     index = [time_column(times_s)]
     for m in meshes:
         path = f"{root}/{m.name}"
-        colors = m.colors if tint_rgba is None else np.tile(
-            np.asarray(tint_rgba, dtype=np.uint8), (len(m.vertices_m), 1))
+        colour = ({"vertex_colors": m.colors} if tint_rgba is None
+                  else {"albedo_factor": list(tint_rgba)})
         rec.log(path, rr.Mesh3D(vertex_positions=m.vertices_m, triangle_indices=m.faces,
-                                vertex_normals=m.normals, vertex_colors=colors), static=True)
+                                vertex_normals=m.normals, **colour), static=True)
         rec.send_columns(path, indexes=index, columns=rr.Transform3D.columns(
             translation=body_pos_m[:, m.body], quaternion=body_quat_xyzw[:, m.body]))
 

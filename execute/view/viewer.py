@@ -63,26 +63,39 @@ def open_in_viewer(path: str | Path, at_s: float | None = None,
 
     recording = Path(path).resolve()
     headless = screenshot is not None
-    hint = ("a headless screenshot needs a Vulkan driver (Debian: mesa-vulkan-drivers)"
-            if headless else f"without a display: rerun --serve-web {path}, then a browser")
     try:
         client = ViewerClient.spawn(headless=headless, hide_welcome_screen=True,
                                     executable_path=_executable())
-        client.open(str(recording))
-        deadline = time.monotonic() + LOAD_TIMEOUT_S
-        while client.get_state().loading:
-            if time.monotonic() > deadline:
-                raise HuboLadderError(f"{path}: Rerun's viewer did not load it in "
-                                      f"{LOAD_TIMEOUT_S:.0f} s")
-            time.sleep(0.2)
-        if at_s is not None:
-            client.set_time(TIMELINE, duration=float(at_s), play_state="paused")
-        if headless:
-            time.sleep(SETTLE_S)
-            client.save_screenshot(str(Path(screenshot).resolve()))
-            client.quit()
     except HuboLadderError:
         raise
     except Exception as exc:  # the viewer is another program: any failure is reported
-        raise HuboLadderError(f"Rerun's viewer could not show {path}: {exc}; {hint}"
-                              ) from None
+        hint = ("a headless viewer needs a Vulkan driver (Debian: mesa-vulkan-drivers)"
+                if headless else f"without a display: rerun --serve-web {path}, then a "
+                "browser")
+        raise HuboLadderError(f"Rerun's viewer did not start: {exc}; {hint}") from None
+    try:
+        _show(client, recording, at_s, screenshot)
+    except HuboLadderError:
+        raise
+    except Exception as exc:
+        raise HuboLadderError(f"Rerun's viewer could not show {path}: {exc}") from None
+    finally:
+        if headless:
+            client.quit()
+
+
+def _show(client, recording: Path, at_s: float | None, screenshot: str | Path | None
+          ) -> None:
+    """Open the file, wait until it is loaded, move the cursor, take the screenshot."""
+    client.open(str(recording))
+    deadline = time.monotonic() + LOAD_TIMEOUT_S
+    while client.get_state().loading:
+        if time.monotonic() > deadline:
+            raise HuboLadderError(f"{recording}: Rerun's viewer did not load it in "
+                                  f"{LOAD_TIMEOUT_S:.0f} s")
+        time.sleep(0.2)
+    if at_s is not None:
+        client.set_time(TIMELINE, duration=float(at_s), play_state="paused")
+    if screenshot is not None:
+        time.sleep(SETTLE_S)
+        client.save_screenshot(str(Path(screenshot).resolve()))
