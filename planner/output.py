@@ -279,12 +279,16 @@ def _metrics(result: SearchResult, planner: ClimbPlanner, timed: TimedPlan,
         "min_clearance_m": _finite(clearance),
         "min_clearance_line": worst_line,
         "clearance_every_lines": clearance_every,
+        "leg_clearance_m": planner.config.leg_clearance_m,
+        "steps_at_min_leg_clearance": sum(st.leg_clearance_m < planner.config.leg_clearance_m
+                                          for st in stats),
         "duration_s": timed.duration_s,
         "search_s": result.total_s,
         "steps": [{"label": st.label, "time_s": st.seconds, "samples": st.samples,
                    "backtracks": st.backtracks, "limb_detours": st.limb_detours,
                    "min_margin_m": _finite(st.min_margin_m),
-                   "max_torque_ratio": st.max_torque_ratio, "failures": dict(st.failures)}
+                   "max_torque_ratio": st.max_torque_ratio, "failures": dict(st.failures),
+                   "leg_clearance_m": _finite(st.leg_clearance_m)}
                   for st in stats],
         "primitives": per_primitive,
     }

@@ -92,6 +92,11 @@ class PlannerConfig:
     # stance leg and the plan, a foot up to 1.5 cm forward on its rung and a loaded leg
     # sagging at its position loops' torque limit (docs/decisions/leg-clearance.md).
     leg_clearance_m: float = 0.025
+    # A step whose first `leg_clearance_samples` samples all fail tries the rest at
+    # `min_leg_clearance_m`, the sag alone: a ladder with short rung spacing (ship,
+    # 0.254 m) has little room for the legs, and the margin then costs minutes of search.
+    min_leg_clearance_m: float = 0.01
+    leg_clearance_samples: int = 10
     arm_strategy: str = DEFAULT_ARM_STRATEGY  # how gripping arms are driven (arm_capacity)
     # Largest planned joint torque / limit, compliant arm joints included (their limit is
     # their PWM clamp). The reserve the legs need is `position_torque_share`'s.
@@ -146,6 +151,7 @@ class StepStats:
     failures: dict[str, int] = field(default_factory=dict)
     limb_detours: int = 0  # limb paths found by RRTConnect where the arc collided
     limb_detour_tries: int = 0
+    leg_clearance_m: float = np.nan  # the legs' clearance the step was found with [m]
 
 
 @dataclass
@@ -648,6 +654,9 @@ class ClimbPlanner:
                          failures[i] * self.config.hold_radius_step_m)
             if time.perf_counter() - t_start > self.config.time_limit_s:
                 raise PlanningFailed(step, f"time limit of {self.config.time_limit_s:g} s reached")
+            relaxed = failures[i] >= self.config.leg_clearance_samples
+            self.collision.set_leg_clearance(self.config.min_leg_clearance_m if relaxed
+                                             else self.config.leg_clearance_m)
             try:
                 segs, q_new, stance_new = self.try_step(step, q, stance, radius, stats[i],
                                                         failures[i])
@@ -672,6 +681,7 @@ class ClimbPlanner:
                     i -= 1
                 continue
             stats[i].seconds += time.perf_counter() - t0
+            stats[i].leg_clearance_m = self.collision.leg_clearance_m
             states.append((segs, q_new, stance_new))
             if progress is not None:
                 progress(i, len(steps), step, stats[i])

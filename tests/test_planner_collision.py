@@ -98,3 +98,15 @@ def test_legs_keep_their_clearance_and_other_links_do_not():
         # the report stays the true distance
         assert with_clearance.report(q).min_distance_m == without.report(q).min_distance_m
         assert 0.004 < without.report(q).min_distance_m < 0.006
+
+
+def test_the_leg_clearance_can_be_relaxed_and_restored():
+    """The search relaxes the legs' clearance for a step that found nothing with it
+    (`PlannerConfig.leg_clearance_samples`): a shin 1.5 cm from the box collides at
+    2.5 cm, not at 1 cm, and again at 2.5 cm."""
+    model, q = _model_with_box_near("L_shin", 0.015, 0.025)
+    assert model.in_collision(q)
+    model.set_leg_clearance(0.01)
+    assert not model.in_collision(q) and model.leg_clearance_m == 0.01
+    model.set_leg_clearance(0.025)
+    assert model.in_collision(q)

@@ -132,11 +132,20 @@ class CollisionModel:
                 self.env_pair_index.append((self.robot_link_of[i], name))
         self.n_self_pairs = len(self.self_pairs)
         self.gdata = pin.GeometryData(geom)
-        for k, (link, env) in enumerate(self.env_pair_index):
-            if link in LEG_LINKS and env != FLOOR:
-                self.gdata.collisionRequests[self.n_self_pairs + k].security_margin = \
-                    leg_clearance_m
+        self._leg_pairs = [self.n_self_pairs + k
+                           for k, (link, env) in enumerate(self.env_pair_index)
+                           if link in LEG_LINKS and env != FLOOR]
+        self.leg_clearance_m = -1.0
+        self.set_leg_clearance(leg_clearance_m)
         self._allowed: frozenset[tuple[str, str]] = frozenset()
+
+    def set_leg_clearance(self, clearance_m: float) -> None:
+        """Keep thighs and shins ``clearance_m`` off the ladder from now on [m]."""
+        if clearance_m == self.leg_clearance_m:
+            return
+        self.leg_clearance_m = clearance_m
+        for idx in self._leg_pairs:
+            self.gdata.collisionRequests[idx].security_margin = clearance_m
 
     def allow(self, contacts: dict[str, str]) -> None:
         """Let each limb's end links touch the object it holds: ``{limb: env name}``."""
