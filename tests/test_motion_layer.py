@@ -178,6 +178,29 @@ def test_a_misplaced_ladder_is_re_grasped_from_sensors(reach):
     assert closed.motion["ladder_shift_m"][0] > 0.01
 
 
+def test_a_compliant_arm_short_of_its_hold_finishes_the_reach_stiff(reach):
+    """Mixed arms: a PWM arm that cannot carry its palm to within the arrival tolerance
+    finishes the reach in position mode, as it moved in the air, and complies again once
+    its grasp is verified. PWM-only arms never leave PWM."""
+    _path, traj, sc, ladder = reach
+    strict = MotionConfig(arrival_tolerance_m=0.004, arrival_timeout_s=1.0)
+    mixed = simulate(traj, sc, ladder, SimulationOptions(record_qpos=False, motion=strict))
+    assert mixed.verdict.climbed, mixed.verdict
+    events = mixed.motion["events"]
+    stiff = [e for e in events if e["kind"] == "stiff reach"]
+    assert stiff and stiff[0]["size_m"] > strict.arrival_tolerance_m
+    wait = next(e for e in events if e["kind"] == "arrival wait" and e["limb"] == stiff[0]["limb"])
+    assert wait["size_m"] < stiff[0]["size_m"]  # position mode brought the palm closer
+    pwm_only = simulate(traj, sc, ladder, SimulationOptions(strategy="pwm", record_qpos=False,
+                                                             motion=strict))
+    assert not any(e["kind"] == "stiff reach" for e in pwm_only.motion["events"])
+    left = [JOINT_INDEX[j] for j in ARM_JOINTS["left"]]
+    compliant = pwm_only.log.pwm[-1, left]  # the joints a gripping arm complies with
+    assert compliant.sum() >= 5 and (pwm_only.log.pwm[:, left] == compliant).all()
+    # on the rail (the plan's last lines), the mixed arm complies again
+    assert (mixed.log.pwm[-1, left] == compliant).all()
+
+
 def test_an_unrecoverable_miss_holds_with_no_weight_shift(reach, tmp_path):
     """Rails 11.5 cm beyond the closing palms, out of the search's reach: the layer stops
     at the grasp, the player never moves on to the lines that load the hands, and the

@@ -14,6 +14,7 @@ class MotionEventKind(enum.Enum):
     GRASP_MISSED = "grasp missed"  #: the fingers closed on nothing
     RE_REACH = "re-reach"  #: a missed hand opens, moves and closes again
     ARRIVAL_WAIT = "arrival wait"  #: a hand lagged its reference; the grasp waited for it
+    STIFF_REACH = "stiff reach"  #: a compliant arm short of its hold finished in position mode
     LADDER_ESTIMATE = "ladder estimate"  #: the estimate of the ladder's pose changed
     STOP = "stop"  #: the layer holds the pose and stops the climb
 

@@ -7,12 +7,17 @@ hubo-motion-rt and the thesis's operator did (thesis §4.3.4, §6.2):
   which run with their PWM clamps at the safety ceiling (`execute.motion.gains`);
 - **arrival**: before a hand closes, the player waits until the encoders put its palm
   within ``arrival_tolerance_m`` of where its reference does (a PWM arm lags its
-  reference), at most ``arrival_timeout_s``;
+  reference), at most ``arrival_timeout_s``. An arm still short of it, if its strategy
+  moved it in position mode in the air (mixed), then finishes the reach in position mode
+  and waits as long again; it complies
+  again once its grasp is verified (the mixed strategy: position in the air, PWM on the
+  rail);
 - **grasp verification**: at the end of every grasp the plan makes, the player waits
   until the finger encoders read the hand closed on its rail
   (`execute.motion.grasp_check`). Only then does the plan go on to put load on it;
-- **re-reach**: a hand that closed on nothing opens, moves to the next point of a small
-  pattern around its target (across the rail, towards and away from the ladder, and
+- **re-reach**: a hand that closed on nothing opens and moves first by the miss the
+  estimate measured (across the rail), then to the next point of a small pattern around
+  its target (across the rail, towards and away from the ladder, and
   sideways), and closes again, up to ``grasp_retries`` times. If it still holds nothing
   the layer **stops**: the player stays paused, every verified grip is kept, and the
   climb ends with the reason. The weight never moves onto an unverified grasp;
@@ -154,6 +159,8 @@ class MotionLayer:
         self._last_ref = np.asarray(trajectory_rad[0], dtype=float).copy()
         self._regrasp: _Regrasp | None = None
         self._open_fingers: set[str] = set()
+        self._stiff_arms: set[str] = set()  # arms held in position mode until they grip
+        self._air_mode: dict[str, str] = {}  # side → the arm's mode as its reach began
         self.events: list[MotionEvent] = []
         self.stop: MotionStop | None = None
         self.estimate: BodyEstimate | None = None
@@ -284,16 +291,25 @@ class MotionLayer:
         return float(np.linalg.norm(got - want))
 
     def _candidates(self, g: _Regrasp) -> list[np.ndarray]:
-        """Re-reach shifts [m]: the ladder estimate's target, then a pattern around it,
-        each within the bound and different from where the hand closed last."""
+        """Re-reach shifts [m]: first the miss as the estimate measured it, taken back
+        across the rail (where the palm closed against where it was sent); then the
+        ladder estimate's target and a pattern around it. Each within the bound and
+        different from where the hand closed last."""
         centre = self._ladder_shift(g.planned_m)
         towards_ladder = -self.geometry.rung_line_normal
         step = self.config.search_step_m
+        current = self._shift_m.get(f"{g.side}_hand", np.zeros(3))
+        axis = self._rail_direction(g.rail)
+        miss = self.estimate.palm_m[g.side] - (g.planned_m + current)
+        miss -= (miss @ axis) * axis
         out: list[np.ndarray] = []
+        measured = self._bounded(current - miss)
+        if np.linalg.norm(measured - current) > SAME_TARGET_M:
+            out.append(measured)
         for across, lateral in ((0, 0),) + SEARCH_PATTERN:
             shift = self._bounded(centre + step * (across * towards_ladder
                                                    + lateral * self.geometry.lateral_direction))
-            tried = [self._shift_m.get(f"{g.side}_hand", np.zeros(3))] + out
+            tried = [current] + out
             if all(np.linalg.norm(shift - t) > SAME_TARGET_M for t in tried):
                 out.append(shift)
         return out
@@ -323,6 +339,18 @@ class MotionLayer:
                 self.player.resume(now)
         elif g.phase == "arrive":
             lag = self._palm_lag_m(g.side, s)
+            if lag > cfg.arrival_tolerance_m and elapsed >= cfg.arrival_timeout_s \
+                    and g.side not in self._stiff_arms \
+                    and self._air_mode.get(g.side) == "position":
+                # the compliant arm cannot carry itself to the hold: it finishes the reach
+                # in position mode, as it moved in the air, until its grasp is verified
+                self._stiff_arms.add(g.side)
+                self._event(MotionEventKind.STIFF_REACH, limb, lag,
+                            f"the compliant arm stayed {lag * 100:.1f} cm from its reference "
+                            f"for {elapsed:.2f} s: it finishes the reach in position mode "
+                            "until the grasp is verified")
+                g.since_s = now
+                return
             if lag <= cfg.arrival_tolerance_m or elapsed >= cfg.arrival_timeout_s:
                 self._arrived.add((g.segment, g.side))
                 if elapsed > 0.0:
@@ -374,6 +402,7 @@ class MotionLayer:
 
     def _grasp_verified(self, g: _Regrasp) -> None:
         limb = f"{g.side}_hand"
+        self._stiff_arms.discard(g.side)  # on the rail: the plan's compliance again
         palm = self.estimate.palm_m[g.side]
         self._verified_segments.add((g.segment, g.side))
         self._settle_offset(limb)
@@ -417,6 +446,10 @@ class MotionLayer:
         if k != self._segment and not tick.going_to_init:
             self._segment = k
             self._enter_segment(k)
+            seg = self.sidecar.segments[k]
+            for limb in seg.moving_limbs:
+                if limb.endswith("_hand") and seg.phase == "limb":  # the arm in the air
+                    self._air_mode[_side(limb)] = tick.arm_modes[_side(limb)]
         if self._regrasp is None and self.stop is None and not tick.going_to_init:
             due = self._grasp_due(tick.line_index)
             if due is not None:
@@ -451,11 +484,19 @@ class MotionLayer:
                 if mode is tick.mode:
                     mode = tick.mode.copy()
                 mode[soft] = RefMode.DIRECT  # the share is the stiffness; no filter lag
+        comply = tick.comply
+        if self._stiff_arms:
+            comply = comply.copy()
+            for side in self._stiff_arms:
+                comply[self._arm_cols[side]] = False
         ff = tick.feedforward_nm
-        if self.config.gravity_compensation and tick.comply.any():  # else ff goes unused
+        if self.config.gravity_compensation and comply.any():  # else ff goes unused
             ff = self.gravity.feedforward_nm(ff, plan_rad, s.pos_rad, self.estimate.R_tilt)
-            ff[~tick.comply] = 0.0
-        return dataclasses.replace(tick, ref_rad=ref, mode=mode, feedforward_nm=ff)
+        if ff is not tick.feedforward_nm or comply is not tick.comply:
+            ff = ff.copy() if ff is tick.feedforward_nm else ff
+            ff[~comply] = 0.0  # feed-forward acts only on compliant joints
+        return dataclasses.replace(tick, ref_rad=ref, mode=mode, comply=comply,
+                                   feedforward_nm=ff)
 
     # ------------------------------------------------------------------ report
     def report(self) -> dict:
