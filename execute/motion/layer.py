@@ -7,18 +7,17 @@ hubo-motion-rt and the thesis's operator did (thesis §4.3.4, §6.2):
   which run with their PWM clamps at the safety ceiling (`execute.motion.gains`);
 - **arrival**: before a hand closes, the player waits until the encoders put its palm
   within ``arrival_tolerance_m`` of where its reference does (a PWM arm lags its
-  reference), at most ``arrival_timeout_s``. An arm still short of it, if its strategy
-  moved it in position mode in the air (mixed), then finishes the reach in position mode
-  and waits as long again; it complies
-  again once its grasp is verified (the mixed strategy: position in the air, PWM on the
-  rail);
+  reference), at most ``arrival_timeout_s``. An arm still short of it, if its schedule
+  moved it in position mode through the air (mixed), then finishes the reach in position
+  mode and waits as long again; it complies again once its grasp is verified (the mixed
+  strategy: position in the air, PWM on the rail);
 - **grasp verification**: at the end of every grasp the plan makes, the player waits
   until the finger encoders read the hand closed on its rail
   (`execute.motion.grasp_check`). Only then does the plan go on to put load on it;
 - **re-reach**: a hand that closed on nothing opens and moves first by the miss the
   estimate measured (across the rail), then to the next point of a small pattern around
-  its target (across the rail, towards and away from the ladder, and
-  sideways), and closes again, up to ``grasp_retries`` times. If it still holds nothing
+  its target (across the rail, towards and away from the ladder, and sideways), and
+  closes again, up to ``grasp_retries`` times. If it still holds nothing
   the layer **stops**: the player stays paused, every verified grip is kept, and the
   climb ends with the reason. The weight never moves onto an unverified grasp;
 - **wrist-roll relief** of a gripping compliant arm (`execute.motion.wrist_relief`), from
@@ -160,7 +159,6 @@ class MotionLayer:
         self._regrasp: _Regrasp | None = None
         self._open_fingers: set[str] = set()
         self._stiff_arms: set[str] = set()  # arms held in position mode until they grip
-        self._air_mode: dict[str, str] = {}  # side → the arm's mode as its reach began
         self.events: list[MotionEvent] = []
         self.stop: MotionStop | None = None
         self.estimate: BodyEstimate | None = None
@@ -328,6 +326,15 @@ class MotionLayer:
                     f"{why}: target moved {np.round(shift * 100, 1).tolist()} cm (IK "
                     f"residual {residual * 1000:.1f} mm)")
 
+    def _stiff_in_air(self, g: _Regrasp) -> bool:
+        """Whether the arm's schedule moved it in position mode through the air on its way
+        to this grasp (the first line of the reach that precedes it)."""
+        limb = f"{g.side}_hand"
+        reach = next((seg for seg in reversed(self.sidecar.segments[:g.segment])
+                      if seg.phase == "limb" and limb in seg.moving_limbs), None)
+        return reach is not None and \
+            not self.player.schedule.pwm_by_line[g.side][reach.first_line - 1]
+
     def _update_regrasp(self, s: SensedState) -> None:
         g, cfg, now = self._regrasp, self.config, self._now
         limb = f"{g.side}_hand"
@@ -340,8 +347,7 @@ class MotionLayer:
         elif g.phase == "arrive":
             lag = self._palm_lag_m(g.side, s)
             if lag > cfg.arrival_tolerance_m and elapsed >= cfg.arrival_timeout_s \
-                    and g.side not in self._stiff_arms \
-                    and self._air_mode.get(g.side) == "position":
+                    and g.side not in self._stiff_arms and self._stiff_in_air(g):
                 # the compliant arm cannot carry itself to the hold: it finishes the reach
                 # in position mode, as it moved in the air, until its grasp is verified
                 self._stiff_arms.add(g.side)
@@ -446,10 +452,6 @@ class MotionLayer:
         if k != self._segment and not tick.going_to_init:
             self._segment = k
             self._enter_segment(k)
-            seg = self.sidecar.segments[k]
-            for limb in seg.moving_limbs:
-                if limb.endswith("_hand") and seg.phase == "limb":  # the arm in the air
-                    self._air_mode[_side(limb)] = tick.arm_modes[_side(limb)]
         if self._regrasp is None and self.stop is None and not tick.going_to_init:
             due = self._grasp_due(tick.line_index)
             if due is not None:
@@ -493,8 +495,7 @@ class MotionLayer:
         if self.config.gravity_compensation and comply.any():  # else ff goes unused
             ff = self.gravity.feedforward_nm(ff, plan_rad, s.pos_rad, self.estimate.R_tilt)
         if ff is not tick.feedforward_nm or comply is not tick.comply:
-            ff = ff.copy() if ff is tick.feedforward_nm else ff
-            ff[~comply] = 0.0  # feed-forward acts only on compliant joints
+            ff = np.where(comply, ff, 0.0)  # feed-forward acts only on compliant joints
         return dataclasses.replace(tick, ref_rad=ref, mode=mode, comply=comply,
                                    feedforward_nm=ff)
 
