@@ -257,6 +257,21 @@ def test_bad_inputs_exit_2_naming_the_file(plan, tmp_path, capsys):
     assert "a screenshot is a .png" in _bad([str(recording), "--screenshot", "x.jpg"], capsys)
 
 
+def test_without_rerun_hubo_view_says_how_to_install_it(plan, tmp_path):
+    """No rerun-sdk: one line that names the extra, for a plan and for a recording, not a
+    traceback from the first module that imports Rerun."""
+    code = ("import sys\nsys.modules['rerun'] = None  # as if rerun-sdk were not installed\n"
+            "from execute.view.cli import main\nsys.exit(main(sys.argv[1:]))")
+    recording = tmp_path / "run.rrd"
+    recording.write_bytes(b"")
+    for argv in ([str(plan[0]), "-o", str(tmp_path / "plan.rrd")], [str(recording), "--open"]):
+        done = subprocess.run([sys.executable, "-c", code, *argv], capture_output=True,
+                              text=True)
+        assert done.returncode == 1, done.stderr
+        assert done.stderr.count("\n") == 1, done.stderr
+        assert "need the rerun-sdk package: pip install -e '.[view]'" in done.stderr
+
+
 def test_validate_plan_refuses_a_bad_record_path_before_simulating(plan, tmp_path, capsys):
     err = _bad([str(plan[0]), "--record", str(tmp_path / "run.mp4")], capsys, validate_main)
     assert "run.mp4: a recording is written as a .rrd file" in err

@@ -71,7 +71,7 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def _kind(path: Path) -> str:
-    """``plan`` or ``result``, from the file's name."""
+    """``plan``, ``result`` or ``recording``, from the file's name."""
     name = path.name
     if name.endswith((".traj", ".traj.gz")):
         return "plan"
@@ -133,7 +133,6 @@ def _write(args: argparse.Namespace, source: Path, kind: str) -> Path | None:
 
     layers = _layers(args)
     start = time.perf_counter()
-    output.require_rerun()
     out = None
     if args.serve:
         rec, address = output.serve(args.web_port or output.WEB_PORT)
@@ -168,6 +167,9 @@ def _run(args: argparse.Namespace) -> int:
     if not source.is_file():
         raise InputError(f"{source}: no such file")
     _check_viewing(args, kind)
+    from execute.view.output import require_rerun
+
+    require_rerun()  # before anything imports it: a one-line message, not a traceback
     out = source if kind == "recording" else _write(args, source, kind)
     if out is None or not (args.open or args.screenshot):
         return 0
