@@ -175,6 +175,9 @@ def test_validate_plan_records_a_run_with_its_grasps(plan, tmp_path):
     assert "Scalars:scalars" in rec["/sim/fingers/tracking_error_rad/LF1"].columns
     assert "/sim/tracking_error_rad/LF1" not in rec
     assert "Arrows3D:vectors" in rec["/world/sim/grip_forces/left"].columns
+    grip = rec["/world/sim/grip_forces/left"]  # the latch's load every 0.1 s while latched
+    assert {"Arrows3D:origins", "Arrows3D:labels", "Arrows3D:colors"} <= grip.columns
+    assert len(grip.times_s) > 10
     assert max(rec["/world/sim/robot/pelvis"].times_s) >= (len(traj) - 1) / sidecar.rate_hz
 
 

@@ -38,6 +38,7 @@ from execute.view.recording import (
     log_static_bodies,
     log_track,
     robot_bodies,
+    time_column,
 )
 from execute.view.scene_meshes import body_meshes
 from robot.joints import FINGER_JOINTS, JOINT_NAMES
@@ -47,8 +48,10 @@ __all__ = ["GHOST_RGBA", "RUN_SERIES", "peak_samples", "record_run", "write_run_
 #: The plan's ghost beside the simulated robot.
 GHOST_RGBA = (90, 150, 255, 90)
 SIM_COM_RGB = (20, 20, 20)
-#: Grip loads are drawn this long per newton [m/N].
+#: Grip loads are drawn this long per newton [m/N], this thick [m], in this colour.
 GRIP_M_PER_N = 0.002
+GRIP_RADIUS_M = 0.006
+GRIP_RGB = (255, 120, 0)
 #: The plots of a run's recording: (entity, title).
 RUN_SERIES = (("/sim/tracking_error_rad", "tracking error pos − ref [rad] (fingers apart)"),
               ("/sim/torque_nm", "joint torque [N·m] (fingers apart)"),
@@ -78,21 +81,27 @@ def _first_time_of_row(line_index: np.ndarray, time_s: np.ndarray):
 
 
 def _log_grips(rec: rr.RecordingStream, run, model: mujoco.MjModel) -> None:
-    """Each latched grip's load (the rail's force on the hand) as an arrow at its palm."""
+    """Each latched grip's load (the rail's force on the hand) as an arrow at its palm,
+    one column batch per hand (a whole climb has tens of thousands of samples)."""
     lg = run.log
     data = mujoco.MjData(model)
     for side, latch in run.board.latches.items():
         path = f"world/sim/grip_forces/{side}"
         site = model.site(f"{side[0].upper()}_palm").id
-        for t, force, _ in latch.load_history:
-            k = min(int(np.searchsorted(lg.time_s, t)), len(lg.time_s) - 1)
-            data.qpos[:] = lg.qpos[k]
-            mujoco.mj_kinematics(model, data)
-            rec.set_time(TIMELINE, duration=float(t))
-            rec.log(path, rr.Arrows3D(origins=[data.site_xpos[site]],
-                                      vectors=[GRIP_M_PER_N * np.asarray(force)],
-                                      labels=[f"{np.linalg.norm(force):.0f} N"],
-                                      colors=[(255, 120, 0)], radii=0.006))
+        if latch.load_history:
+            times = np.array([t for t, _, _ in latch.load_history])
+            forces = np.array([f for _, f, _ in latch.load_history])
+            ticks = np.minimum(np.searchsorted(lg.time_s, times), len(lg.time_s) - 1)
+            palms = np.empty((len(ticks), 3))
+            for i, k in enumerate(ticks):
+                data.qpos[:] = lg.qpos[k]
+                mujoco.mj_kinematics(model, data)
+                palms[i] = data.site_xpos[site]
+            rec.send_columns(path, indexes=[time_column(times)], columns=rr.Arrows3D.columns(
+                origins=palms, vectors=GRIP_M_PER_N * forces,
+                labels=[f"{n:.0f} N" for n in np.linalg.norm(forces, axis=1)],
+                colors=np.tile(GRIP_RGB, (len(times), 1)),
+                radii=np.full(len(times), GRIP_RADIUS_M)))
         for g in lg.grasps:  # a hand that lets go carries no load
             if g.hand == side and g.kind != "latched":
                 rec.set_time(TIMELINE, duration=g.time_s)
