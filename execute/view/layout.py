@@ -37,14 +37,12 @@ def blueprint(series: Sequence[tuple[str, str]], failure_s: float | None = None
     """
     right = [rrb.TextLogView(origin="/events", name="events")]
     right += [rrb.TimeSeriesView(origin=path, name=title) for path, title in series]
-    panel = rrb.TimePanel(timeline=TIMELINE, playback_speed=1.0)
+    loop = {}
     if failure_s is not None:
         lo = max(0.0, failure_s - BEFORE_FAILURE_S)
-        panel = rrb.TimePanel(timeline=TIMELINE, playback_speed=1.0, loop_mode="selection",
-                              time_selection=AbsoluteTimeRange(
-                                  TimeInt(seconds=lo),
-                                  TimeInt(seconds=failure_s + AFTER_FAILURE_S)))
+        loop = {"loop_mode": "selection", "time_selection": AbsoluteTimeRange(
+            TimeInt(seconds=lo), TimeInt(seconds=failure_s + AFTER_FAILURE_S))}
     return rrb.Blueprint(
         rrb.Horizontal(rrb.Spatial3DView(origin="/world", name="climb"),
                        rrb.Vertical(*right), column_shares=[3, 2]),
-        panel, collapse_panels=False)
+        rrb.TimePanel(timeline=TIMELINE, playback_speed=1.0, **loop), collapse_panels=False)

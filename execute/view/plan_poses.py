@@ -93,11 +93,6 @@ class PlanKinematics:
         self._columns = np.array([JOINT_NAMES.index(n) for n in addresses])
         self._qpos_index = np.array(list(addresses.values()))
 
-    def region(self, segment: int):
-        """The support region of a segment's balancing holds
-        (`planner.statics.com_region.SupportRegion`)."""
-        return self.verifier.stance(segment, self.sidecar.segments[segment]).region
-
     def poses(self, rows: np.ndarray, statics: bool = True) -> PlanPoses:
         """The robot on ``rows`` (0-based lines, any order); with ``statics``, the
         stability margin too (it computes each segment's support region once)."""

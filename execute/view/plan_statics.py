@@ -60,8 +60,8 @@ class HoldForces:
 
 
 def support_polygon(kin: PlanKinematics, si: int) -> SupportPolygon:
-    """Segment ``si``'s support region (`PlanKinematics.region`), at the mean height of
-    the segment's held feet (the floor if none)."""
+    """Segment ``si``'s support region (the verifier's, on the holds that may balance the
+    robot), at the mean height of the segment's held feet (the floor if none)."""
     seg = kin.sidecar.segments[si]
     held = kin.verifier.stance(si, seg)
     feet = [h.position_m[2] for limb, h in seg.holds.items() if limb.endswith("_foot")]
