@@ -167,6 +167,17 @@ def sidecar_path(traj_path: str | os.PathLike) -> Path:
     return p.with_name(p.name + ".plan.json")
 
 
+def check_line_count(traj_path: str | os.PathLike, lines: int, sidecar: PlanSidecar) -> None:
+    """Refuse a trajectory of ``lines`` lines whose sidecar counts another number.
+
+    Raises:
+        InputError: naming the file, its line count and the sidecar's.
+    """
+    if lines != sidecar.line_count:
+        raise InputError(f"{traj_path}:{lines}: the file has {lines} lines, its sidecar "
+                         f"{sidecar_path(traj_path)} says {sidecar.line_count}")
+
+
 def write_sidecar(path: str | os.PathLike, sidecar: PlanSidecar) -> None:
     path = Path(path)
     tmp = path.with_name(path.name + ".tmp")

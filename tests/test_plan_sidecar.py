@@ -23,8 +23,13 @@ from ladders.loader import (  # noqa: E402
     sidecar_ladder,
 )
 from planner.output import write_plan  # noqa: E402
-from robot.errors import LadderSpecError  # noqa: E402
-from robot.plan_sidecar import VERSION, SidecarError, read_sidecar  # noqa: E402
+from robot.errors import InputError, LadderSpecError  # noqa: E402
+from robot.plan_sidecar import (  # noqa: E402
+    VERSION,
+    SidecarError,
+    check_line_count,
+    read_sidecar,
+)
 
 
 @pytest.fixture(scope="module")
@@ -118,3 +123,14 @@ def test_the_sidecar_s_ladder_is_checked_by_the_spec_s_rules():
         ladder_from_mapping({**mapping, "rails": {}}, "x")
     with pytest.raises(LadderSpecError, match="section 'geometry' is list"):
         ladder_from_mapping({**mapping, "geometry": []}, "x")
+
+
+def test_a_trajectory_and_a_sidecar_that_count_different_lines_are_refused(document,
+                                                                           tmp_path):
+    sidecar = _read(tmp_path, document)
+    check_line_count(tmp_path / "x.traj", sidecar.line_count, sidecar)  # agree: no error
+    with pytest.raises(InputError) as err:
+        check_line_count(tmp_path / "x.traj.gz", sidecar.line_count - 1, sidecar)
+    words = str(err.value)
+    assert f"x.traj.gz:{sidecar.line_count - 1}:" in words and "x.plan.json" in words
+    assert f"says {sidecar.line_count}" in words

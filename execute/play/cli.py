@@ -119,7 +119,7 @@ def _load(args):
         TrajectoryPlayer,
         compliant_arms_from_flags,
     )
-    from robot.plan_sidecar import read_sidecar, sidecar_path
+    from robot.plan_sidecar import check_line_count, read_sidecar, sidecar_path
     from robot.trajectory_file import format_clamps, read_trajectory, read_trajectory_clamped
 
     path = Path(args.file)
@@ -138,9 +138,8 @@ def _load(args):
         if clamps:
             print(f"play-trajectory: {format_clamps(str(path), clamps, args.clamp_limits)}",
                   file=sys.stderr, flush=True)
-    if sidecar and len(traj) != sidecar.line_count:
-        raise InputError(f"{path}:{len(traj)}: the file has {len(traj)} lines, its sidecar "
-                         f"{side} says {sidecar.line_count}")
+    if sidecar:
+        check_line_count(path, len(traj), sidecar)
     auto = sidecar is not None and not args.no_auto_modes
     schedule = sidecar.arm_modes if auto else None
     opts = PlayerOptions(rate_hz=rate, go_to_init=args.init, go_to_init_s=args.init_s,

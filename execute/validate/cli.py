@@ -191,7 +191,7 @@ def _run(args: argparse.Namespace) -> int:
     from execute.validate.plan_compare import compare_with_plan
     from execute.validate.simulate import SimulationOptions, simulate
     from ladders.loader import load_ladder
-    from robot.plan_sidecar import read_sidecar, sidecar_path
+    from robot.plan_sidecar import check_line_count, read_sidecar, sidecar_path
     from robot.progress import ProgressReporter
     from robot.trajectory_file import read_trajectory
 
@@ -207,9 +207,7 @@ def _run(args: argparse.Namespace) -> int:
     sidecar = read_sidecar(side)
     robot = args.robot or sidecar.robot
     traj = read_trajectory(plan, sidecar.rate_hz, robot)
-    if len(traj) != sidecar.line_count:
-        raise InputError(f"{plan}:{len(traj)}: the file has {len(traj)} lines, its sidecar "
-                         f"{side} says {sidecar.line_count}")
+    check_line_count(plan, len(traj), sidecar)
     ladder = load_ladder(args.ladder) if args.ladder else ladder_from_sidecar(
         sidecar.ladder, f"{side}: ladder")
     board_cfg = BoardModelConfig(battery_v=args.battery)

@@ -48,7 +48,7 @@ def read_plan(path: str | Path) -> Plan:
             disagreeing on the line count; the message names the file.
     """
     from ladders.loader import sidecar_ladder
-    from robot.plan_sidecar import read_sidecar, sidecar_path
+    from robot.plan_sidecar import check_line_count, read_sidecar, sidecar_path
     from robot.trajectory_file import read_trajectory
 
     plan = Path(path)
@@ -60,9 +60,7 @@ def read_plan(path: str | Path) -> Plan:
                          "segments and holds that plan-ladder writes beside the trajectory")
     sidecar = read_sidecar(side)
     traj = read_trajectory(plan, sidecar.rate_hz, sidecar.robot, check_speed=False)
-    if len(traj) != sidecar.line_count:
-        raise InputError(f"{plan}:{len(traj)}: the file has {len(traj)} lines, its sidecar "
-                         f"{side} says {sidecar.line_count}")
+    check_line_count(plan, len(traj), sidecar)
     return Plan(plan, traj, sidecar, sidecar_ladder(sidecar, str(side)))
 
 
