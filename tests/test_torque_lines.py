@@ -17,7 +17,7 @@ from ladders.loader import load_ladder  # noqa: E402
 from planner.contacts import Stance  # noqa: E402
 from planner.statics.torque_lp import torque_feasibility  # noqa: E402
 from planner.verify.check import _Verifier  # noqa: E402
-from planner.verify.line_pass import _utilisation  # noqa: E402
+from planner.verify.line_pass import _grip_use, _utilisation  # noqa: E402
 from planner.verify.torque_lines import StanceLines  # noqa: E402
 from robot.plan_sidecar import HoldRecord, read_sidecar, sidecar_path  # noqa: E402
 
@@ -66,3 +66,28 @@ def test_grip_use_of_many_wrenches_is_the_latch_capacitys():
     for i in range(50):
         one = limits.utilisation(force[i], torque[i])
         np.testing.assert_allclose(use[i], [one[load] for load in GRIP_LOADS], rtol=1e-12)
+
+
+def test_grip_use_names_the_grip_as_the_per_line_account_does():
+    """The batch's most used grip limit and its clause are `contact_wrench_utilisation`'s
+    on the same wrench; no load on a grip is "no grip"."""
+    from types import SimpleNamespace
+
+    from ladders.contact_model import hand_limits
+    from planner.statics.torque_lp import TorqueCheck
+    from planner.verify.check import contact_wrench_utilisation
+    from planner.verify.torque_lines import LineTorques
+
+    limits = hand_limits(0.4, 0.025, np.array([0.3, 0.0, 0.95]))
+    hand = SimpleNamespace(limb="right_hand", limits=limits)
+    wrenches = np.array([[0.0, 30.0, 140.0, 1.0, -2.0, 0.5], np.zeros(6)])
+    lp = LineTorques(np.ones(2, dtype=bool), np.full(2, 0.5), np.zeros(2, dtype=int),
+                     {"right_hand": wrenches})
+    use, clause = _grip_use([hand], lp)
+    for i, w in enumerate(wrenches):
+        one = TorqueCheck(True, True, 0.5, "", wrenches={"right_hand": (w[:3], w[3:])},
+                          contact_use={"right_hand": limits.utilisation(w[:3], w[3:])})
+        expected = contact_wrench_utilisation(one)
+        assert use[i] == pytest.approx(expected.value, rel=1e-12)
+        assert clause(i) == expected.detail
+    assert clause(1) == "no grip"

@@ -38,6 +38,10 @@ class JointPoses(NamedTuple):
         R_j, p_j = self.R[:, parent], self.p[:, parent]
         return R_j @ R_joint_frame, p_j + R_j @ p_joint_frame
 
+    def subset(self, idx: np.ndarray) -> JointPoses:
+        """The lines ``idx`` of this batch."""
+        return JointPoses(self.R[idx], self.p[idx])
+
 
 class PinConfigurations:
     """pinocchio configurations of a batch of lines, built on demand (the few lines that

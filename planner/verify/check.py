@@ -221,10 +221,15 @@ def contact_wrench_utilisation(check: TorqueCheck) -> ContactLoad:
     limb, load, use = check.worst_contact(hands_only=True)
     if not limb:
         return ContactLoad(0.0, "", "", "no grip")
-    force, torque = check.wrenches[limb]
-    return ContactLoad(use, limb, load, f"{limb} {load} {use:.2f} of its limit "
-                       f"(|F| = {np.linalg.norm(force):.0f} N, |T| = "
-                       f"{np.linalg.norm(torque):.1f} N·m)")
+    return ContactLoad(use, limb, load, _grip_clause(limb, load, use, *check.wrenches[limb]))
+
+
+def _grip_clause(limb: str, load: str, use: float, force: np.ndarray, torque: np.ndarray
+                 ) -> str:
+    """The report's clause on a grip's most used limit: which, its use [share of it], and
+    the grip's force [N] and torque [N·m]."""
+    return (f"{limb} {load} {use:.2f} of its limit (|F| = {np.linalg.norm(force):.0f} N, "
+            f"|T| = {np.linalg.norm(torque):.1f} N·m)")
 
 
 class _SegmentStance(NamedTuple):

@@ -21,6 +21,7 @@ from ladders.contact_model import GRIP_LOADS
 from robot.plan_sidecar import Segment
 
 if TYPE_CHECKING:
+    from planner.contacts import Hold
     from planner.verify.batch_kinematics import JointPoses
     from planner.verify.check import CheckResult, _Verifier
     from planner.verify.torque_lines import LineTorques
@@ -82,7 +83,7 @@ def check_lines(res: dict[str, CheckResult], v: _Verifier, traj_rad: np.ndarray,
     idx = np.flatnonzero(mine)
     if not len(idx):
         return
-    sub = type(poses)(poses.R[idx], poses.p[idx])
+    sub = poses.subset(idx)
     _check_collisions(res["collision"], v, sub, q.subset(idx), lines[idx], segs, si, label)
     held = v.stance(si, seg)
     margin = np.asarray(held.region.margin(v.kin.com(sub)), dtype=float)
@@ -92,7 +93,7 @@ def check_lines(res: dict[str, CheckResult], v: _Verifier, traj_rad: np.ndarray,
                           f"region of {balance}")
     ok = np.flatnonzero(margin >= 0.0)  # the torque LP only where the CoM is inside
     if len(ok):
-        lp = v.stance_lines(si, seg).solve(type(sub)(sub.R[ok], sub.p[ok]))
+        lp = v.stance_lines(si, seg).solve(sub.subset(ok))
         _check_loads(res, v, lp, q.subset(idx[ok]), lines[idx[ok]], si, seg, label)
 
 
@@ -139,8 +140,7 @@ def _check_collisions(result: CheckResult, v: _Verifier, poses: JointPoses, q,
             continue
         active = v.collision_lines.active(allowed_contacts(segs, si, float(frac[part[0]])))
         wanted = np.flatnonzero((lines[part] - 1) % CLEARANCE_EVERY_LINES == 0)
-        out = v.collision_lines.check(type(poses)(poses.R[part], poses.p[part]),
-                                      q.subset(part), active, wanted)
+        out = v.collision_lines.check(poses.subset(part), q.subset(part), active, wanted)
         hit[part], clear[part] = out.hit, out.clearance_m
         pair.update({int(part[i]): p for i, p in out.pair.items()})
     shown = np.flatnonzero(hit | ~np.isnan(clear))
@@ -162,49 +162,45 @@ def _check_loads(res: dict[str, CheckResult], v: _Verifier, lp: LineTorques, q,
     offer_lines(res["torque ratio"], lines, lp.max_ratio, lp.max_ratio, ~feasible,
                 lambda i: f"{label}: worst joint "
                           f"{names[lp.worst_joint[i]] if lp.worst_joint[i] >= 0 else ''}")
-    use, limb, load, force, torque = _grip_use(v, lp, si, seg)
-    fallback: dict[int, ContactLoad] = {}
     held = v.stance(si, seg)
+    use, grip_clause = _grip_use(held.stance.holds, lp)
+    fallback: dict[int, ContactLoad] = {}
     for i in np.flatnonzero(~feasible):
         fallback[int(i)] = contact_wrench_utilisation(torque_feasibility(
             v.model, v.data, q[i], held.stance, held.torque_limits, v.frame_id,
             objective="contact"))
         use[i] = fallback[int(i)].value
-
-    def detail(i: int) -> str:
-        if i in fallback:
-            return f"{label}: {fallback[i].detail}"
-        if not limb[i]:
-            return f"{label}: no grip"
-        return (f"{label}: {limb[i]} {load[i]} {use[i]:.2f} of its limit (|F| = "
-                f"{np.linalg.norm(force[i]):.0f} N, |T| = {np.linalg.norm(torque[i]):.1f} "
-                "N·m)")
-
-    offer_lines(res["contact wrench"], lines, use, use, use > 1.0 + 1e-6, detail)
+    offer_lines(res["contact wrench"], lines, use, use, use > 1.0 + 1e-6,
+                lambda i: f"{label}: {fallback[i].detail if i in fallback else grip_clause(i)}")
 
 
-def _grip_use(v: _Verifier, lp: LineTorques, si: int, seg: Segment):
-    """Per line, the most used grip limit of the LP's wrenches (`TorqueCheck.worst_contact`
-    with ``hands_only``: the first hand and limit in order at the largest use; 0 and no
-    limb when no grip is used): use, limb, limit, and that hand's force and torque."""
+def _grip_use(holds: Sequence[Hold], lp: LineTorques
+              ) -> tuple[np.ndarray, Callable[[int], str]]:
+    """Per line, the use of the most used grip limit of the LP's wrenches
+    (`TorqueCheck.worst_contact` with ``hands_only``: the first hand and limit in order at
+    the largest use; 0 when no grip is used), and the report's clause on it for line i
+    (`contact_wrench_utilisation`'s)."""
+    from planner.verify.check import _grip_clause
+
     L = len(lp.max_ratio)
     uses, who = [np.zeros((L, 1))], [("", "")]
-    wrench = {}
-    for hold in v.stance(si, seg).stance.holds:
-        if hold.limb not in lp.grip_wrench:
-            continue
-        w = lp.grip_wrench[hold.limb]
-        wrench[hold.limb] = w
-        uses.append(_utilisation(hold.limits, w[:, :3], w[:, 3:]))
-        who += [(hold.limb, load) for load in GRIP_LOADS]
+    for hold in holds:
+        if hold.limb in lp.grip_wrench:
+            w = lp.grip_wrench[hold.limb]
+            uses.append(_utilisation(hold.limits, w[:, :3], w[:, 3:]))
+            who += [(hold.limb, load) for load in GRIP_LOADS]
     all_uses = np.hstack(uses)
     best = np.argmax(all_uses, axis=1)  # column 0 (no grip, 0) wins unless one is larger
     use = all_uses[np.arange(L), best]
-    limb = [who[b][0] for b in best]
-    load = [who[b][1] for b in best]
-    force = np.array([wrench[lb][i, :3] if lb else np.zeros(3) for i, lb in enumerate(limb)])
-    torque = np.array([wrench[lb][i, 3:] if lb else np.zeros(3) for i, lb in enumerate(limb)])
-    return use, limb, load, force.reshape(L, 3), torque.reshape(L, 3)
+
+    def clause(i: int) -> str:
+        limb, load = who[best[i]]
+        if not limb:
+            return "no grip"
+        w = lp.grip_wrench[limb][i]
+        return _grip_clause(limb, load, use[i], w[:3], w[3:])
+
+    return use, clause
 
 
 def _utilisation(limits, force: np.ndarray, torque: np.ndarray) -> np.ndarray:
@@ -214,14 +210,13 @@ def _utilisation(limits, force: np.ndarray, torque: np.ndarray) -> np.ndarray:
     axis = limits.rail_frame()[:, 0]
     fa, ta = force @ axis, torque @ axis
     radial = np.linalg.norm(force - fa[:, None] * axis, axis=1)
-    along = cap.friction * (2.0 * cap.squeeze_n + radial)
 
     def ratio(load, capacity):
         with np.errstate(divide="ignore", invalid="ignore"):
             return np.where(capacity > 0.0, load / np.where(capacity > 0.0, capacity, 1.0),
                             np.where(load > 0.0, math.inf, 0.0))
 
-    return np.column_stack([radial / cap.radial_n, ratio(np.abs(fa), along),
-                            ratio(np.abs(ta), along * cap.rail_radius_m),
+    return np.column_stack([radial / cap.radial_n, ratio(np.abs(fa), cap.along_n(radial)),
+                            ratio(np.abs(ta), cap.about_nm(radial)),
                             np.linalg.norm(torque - ta[:, None] * axis, axis=1)
                             / cap.bending_nm])
