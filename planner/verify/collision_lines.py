@@ -148,22 +148,25 @@ class CollisionLines:
         pairs = geom.collisionPairs
         self.first = np.array([cp.first for cp in pairs])
         self.second = np.array([cp.second for cp in pairs])
+        # Each pair's kind: robot–robot, robot–environment capsule, robot–floor.
         self.is_env = self.second >= n
+        self.env = np.where(self.is_env, self.second - n, 0)  # its environment object
+        self.to_floor = self.is_env & self.env_floor[self.env]
+        self.to_capsule = self.is_env & ~self.to_floor
         self.margin = np.array([collision.gdata.collisionRequests[k].security_margin
                                 for k in range(len(pairs))])
         self.names = [(objs[cp.first].name, objs[cp.second].name) for cp in pairs]
-        self.link_of = collision.robot_link_of
-        self.env_names = collision.env_names
 
     # ----------------------------------------------------------------- pair activity
     def active(self, contacts: dict[str, str]) -> np.ndarray:
-        """(pairs,) which pairs `CollisionModel.allow` leaves active for ``contacts``."""
+        """(pairs,) which pairs `CollisionModel.allow` leaves active for ``contacts``: the
+        self pairs, and the environment pairs (`CollisionModel.env_pair_index`, after
+        them) but those of a limb's end links and what it holds."""
         allowed = {(link, target) for limb, target in contacts.items()
                    for link in LIMB_END_LINKS[limb]}
+        col = self.collision
         out = np.ones(len(self.first), dtype=bool)
-        for k in np.flatnonzero(self.is_env):
-            pair = (self.link_of[self.first[k]], self.env_names[self.second[k] - self.n_robot])
-            out[k] = pair not in allowed
+        out[col.n_self_pairs:] = [pair not in allowed for pair in col.env_pair_index]
         return out
 
     # ----------------------------------------------------------------- bounds
@@ -178,18 +181,14 @@ class CollisionLines:
                     ) -> np.ndarray:
         """Lower bound of pair ``k[i]``'s distance on line ``lines[i]``, from the capsule
         ends a, b (L, n, 3)."""
-        f, s = self.first[k], self.second[k]
+        f, s, e = self.first[k], self.second[k], self.env[k]
         a1, b1 = a[lines, f], b[lines, f]
         out = np.empty(len(k))
-        env = self.is_env[k]
-        e = s - self.n_robot
-        floor = env & self.env_floor[np.where(env, e, 0)]
-        rob = ~env
+        rob, cap, floor = ~self.is_env[k], self.to_capsule[k], self.to_floor[k]
         if rob.any():
             lr, sr = lines[rob], s[rob]
             out[rob] = (segment_distance(a1[rob], b1[rob], a[lr, sr], b[lr, sr])
                         - self.radius[f[rob]] - self.radius[sr])
-        cap = env & ~floor
         if cap.any():
             out[cap] = segment_distance(a1[cap], b1[cap], self.env_a[e[cap]], self.env_b[e[cap]]
                                         ) - self.radius[f[cap]] - self.env_radius[e[cap]]
@@ -209,14 +208,11 @@ class CollisionLines:
         centre = (mid.max(axis=1) + mid.min(axis=1)) / 2
         spread = np.linalg.norm(mid - centre[:, None], axis=3).max(axis=1)
         R = spread + self.reach  # (windows, n) swept sphere radii
-        f, s = self.first, self.second
+        f, s, e = self.first, self.second, self.env
         out = np.empty((n_win, len(f)))
-        rob = ~self.is_env
+        rob, cap, floor = ~self.is_env, self.to_capsule, self.to_floor
         out[:, rob] = (np.linalg.norm(centre[:, f[rob]] - centre[:, s[rob]], axis=2)
                        - R[:, f[rob]] - R[:, s[rob]])
-        e = s - self.n_robot
-        floor = self.is_env & self.env_floor[np.where(self.is_env, e, 0)]
-        cap = self.is_env & ~floor
         c = centre[:, f[cap]]
         out[:, cap] = (segment_distance(c, c, self.env_a[e[cap]], self.env_b[e[cap]])
                        - R[:, f[cap]] - self.env_radius[e[cap]])
