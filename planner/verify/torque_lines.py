@@ -40,9 +40,8 @@ from ladders.contact_model import HandLimits
 from planner.statics.config import StabilityConfig, StabilityError, default_config
 from planner.statics.contact_wrenches import cone_edges_cached, grip_rows, split_wrench_basis
 from planner.statics.highs_lp import dense_lp, quiet_highs
-from planner.statics.torque_lp import GRIP_LOAD_COST
+from planner.statics.torque_lp import GRIP_LOAD_COST, _actuated
 from planner.verify.batch_kinematics import BatchKinematics, JointPoses
-from robot.errors import HuboLadderError
 
 __all__ = ["BASIS_TOL", "LineTorques", "StanceLines"]
 
@@ -51,8 +50,9 @@ __all__ = ["BASIS_TOL", "LineTorques", "StanceLines"]
 BASIS_TOL = 1e-7
 #: Joints whose torque ratios differ by less than this share the worst one [-].
 TIE_RATIO = 1e-9
-#: Lines tested at once against a basis, at most.
-MAX_WINDOW = 256
+#: Lines tested at once against a basis: at first and after a failed test, and at most
+#: (the window doubles while the basis holds).
+MIN_WINDOW, MAX_WINDOW = 32, 256
 _LOWER, _BASIC, _UPPER = 0, 1, 2  # highspy.HighsBasisStatus values
 _SPLIT = split_wrench_basis(np.zeros(3))  # (6, 12) a grip's wrench from its variables
 
@@ -93,9 +93,10 @@ class _BasisRows(NamedTuple):
 
 
 class _Basis(NamedTuple):
-    col_status: np.ndarray
-    row_status: np.ndarray
-    highs: object  # the highspy.HighsBasis, for a warm start
+    """HiGHS's last optimal basis: for a warm start, and in the LP's structure for the
+    test on the following lines (None: the test does not apply)."""
+
+    highs: object  # the highspy.HighsBasis
     rows: _BasisRows | None
 
 
@@ -140,16 +141,10 @@ class StanceLines:
         cfg = config or default_config()
         model = kin.model
         self.kin = kin
-        joints = [j for j in range(2, model.njoints)]
-        missing = [model.names[j] for j in joints
-                   if torque_max_nm_by_joint.get(model.names[j], 0.0) <= 0.0]
-        if missing:
-            raise HuboLadderError(f"no positive torque limit for joints {missing}; limits "
-                                  f"given for {sorted(torque_max_nm_by_joint)}")
-        self.joint_names = tuple(model.names[j] for j in joints)
-        self.v_idx = kin.idx_v[joints]
-        self.tmax = np.array([torque_max_nm_by_joint[n] for n in self.joint_names])
-        self.weight_n = kin.total_mass * float(np.linalg.norm(kin.gravity))
+        # The actuated joints, their velocity indices and limits, and the weight [N]:
+        # `torque_feasibility`'s.
+        self.joint_names, self.v_idx, self.tmax, self.weight_n = _actuated(
+            model, torque_max_nm_by_joint)
         self.holds: list[_Hold] = []
         starts, costs, grips = [0], [], []
         for hold in holds:
@@ -252,7 +247,7 @@ class StanceLines:
         L = len(lower)
         X = np.full((L, self.n_c + 1), np.nan)
         ok = np.zeros(L, dtype=bool)
-        i, window = 0, 32
+        i, window = 0, MIN_WINDOW
         while i < L:
             if self._basis is not None and self._basis.rows is not None:
                 j = min(L, i + window)
@@ -264,7 +259,7 @@ class StanceLines:
                 if n == len(passed):  # the basis holds on the whole window
                     window = min(2 * window, MAX_WINDOW)
                     continue
-                window = max(32, n)
+                window = max(MIN_WINDOW, n)
             status, x = self._highs(self._matrix(terms, i), lower[i], upper[i])
             if status == "optimal":
                 X[i], ok[i] = x, True
@@ -391,5 +386,5 @@ class StanceLines:
         b = h.getBasis()
         cs = np.array([int(s) for s in b.col_status])
         rs = np.array([int(s) for s in b.row_status])
-        self._basis = _Basis(cs, rs, b, self._rows_of(cs, rs))
+        self._basis = _Basis(b, self._rows_of(cs, rs))
         return "optimal", np.array(h.getSolution().col_value)
