@@ -21,7 +21,7 @@ import math
 import os
 import re
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -220,9 +220,14 @@ def _parse_plain(text: str, limits, rate_hz: float, check_speed: bool) -> np.nda
 
 
 def _parse(text: str, source: str, rate_hz: float, robot: str, check_speed: bool,
-           clamp_tol_rad: float) -> tuple[np.ndarray, tuple[ClampedJoint, ...]]:
-    """`parse_trajectory`, clamping values within ``clamp_tol_rad`` beyond a limit."""
+           clamp_tol_rad: float, check_limits: bool = True
+           ) -> tuple[np.ndarray, tuple[ClampedJoint, ...]]:
+    """`parse_trajectory`, clamping values within ``clamp_tol_rad`` beyond a limit, or
+    reading them as they are if not ``check_limits`` (joint positions unbounded)."""
     limits = joint_limits(robot)
+    if not check_limits:
+        unbounded = np.full(NUM_JOINTS, np.inf)
+        limits = replace(limits, lower_rad=-unbounded, upper_rad=unbounded)
     plain = _parse_plain(text, limits, rate_hz, check_speed)
     if plain is not None:  # nothing to report, nothing to clamp
         return plain, ()
@@ -333,9 +338,12 @@ def _clamp_report(clamped: dict[int, list[tuple[int, float, float, float]]]
 
 
 def read_trajectory(path: str | os.PathLike, rate_hz: float, robot: str = "drc-hubo",
-                    check_speed: bool = True) -> np.ndarray:
-    """Read and validate a 40-column file; see ``parse_trajectory``."""
-    return _parse(_read_text(path), str(path), rate_hz, robot, check_speed, 0.0)[0]
+                    check_speed: bool = True, check_limits: bool = True) -> np.ndarray:
+    """Read and validate a 40-column file; see ``parse_trajectory``. Without
+    ``check_limits``, values beyond a joint's limits are read as they are (check-plan
+    reports them itself)."""
+    return _parse(_read_text(path), str(path), rate_hz, robot, check_speed, 0.0,
+                  check_limits)[0]
 
 
 def read_trajectory_clamped(path: str | os.PathLike, rate_hz: float, clamp_tol_rad: float,

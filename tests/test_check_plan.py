@@ -75,6 +75,19 @@ def test_joint_past_its_limit_fails_naming_the_line(good, tmp_path, capsys):
     assert "velocity fails at line 100" in err
 
 
+def test_a_malformed_file_names_its_joints_past_their_limits_too(good, tmp_path, capsys):
+    """The file is read once without the limits (check-plan reports them itself); a
+    malformed one is bad input whose message names every problem, limits included."""
+    bad = _knee_past_its_limit(good, tmp_path / "both.traj")
+    lines = bad.read_text().splitlines()
+    lines[6] = lines[6].replace(" ", " oops ", 1)
+    bad.write_text("\n".join(lines) + "\n")
+    assert main([str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert f"{bad}:7:" in err and "'oops' is not a number" in err
+    assert f"{bad}:100:" in err and "(RKN)" in err and "outside the joint limits" in err
+
+
 def test_bad_input_exits_2(good, tmp_path, capsys):
     lone = tmp_path / "lone.traj"
     shutil.copy(good, lone)

@@ -165,6 +165,30 @@ def test_value_outside_joint_limit_is_refused(tmp_path):
     assert "bad.traj:1:" in msg and "(LKN)" in msg and "[0, 2.61]" in msg
 
 
+def test_values_past_a_limit_are_read_as_they_are_without_the_limit_check(monkeypatch,
+                                                                           tmp_path):
+    """check-plan reads a file once, its values beyond the limits as written: at once and
+    line by line alike; other problems are still refused."""
+    import robot.trajectory_file as tf
+
+    q = _smooth_trajectory(20)
+    q[5:8, JOINT_NAMES.index("LKN")] = -0.2  # knees do not bend backwards
+    path = tmp_path / "past.traj"
+    write_trajectory(path, q)
+    assert "(LKN)" in _fail(path)
+    at_once = read_trajectory(path, 25.0, check_speed=False, check_limits=False)
+    assert np.array_equal(at_once, np.round(q, 9) + 0.0)
+    monkeypatch.setattr(tf, "_parse_plain", lambda *args: None)
+    assert np.array_equal(at_once, read_trajectory(path, 25.0, check_speed=False,
+                                                   check_limits=False))
+    lines = path.read_text().splitlines()
+    lines[2] = "0 0 0"
+    with pytest.raises(TrajectoryFileError) as err:
+        read_trajectory(_write_lines(tmp_path, lines), 25.0, check_speed=False,
+                        check_limits=False)
+    assert [p.split(":")[1] for p in err.value.problems] == ["3"]
+
+
 def test_every_problem_is_reported_not_only_the_first(tmp_path):
     lines = format_trajectory(_smooth_trajectory(6)).splitlines()
     lines[1] = "0 0 0"

@@ -40,16 +40,16 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def _read(path: Path, rate_hz: float, robot: str) -> np.ndarray:
-    """Read a trajectory: format errors are bad input; joint values beyond the limits
-    are read anyway (the joint-limit check reports them)."""
+    """Read a trajectory once: joint values beyond the limits are read as they are (the
+    joint-limit check reports them); format errors are bad input."""
     from robot.trajectory_file import read_trajectory
 
     try:
-        return read_trajectory(path, rate_hz, robot, check_speed=False)
-    except TrajectoryFileError as exc:
-        if not all("outside the joint limits" in p for p in exc.problems):
-            raise
-    return np.loadtxt(path, ndmin=2)
+        return read_trajectory(path, rate_hz, robot, check_speed=False, check_limits=False)
+    except TrajectoryFileError:
+        pass
+    # A malformed file: its error names every problem, values beyond the limits too.
+    return read_trajectory(path, rate_hz, robot, check_speed=False)
 
 
 def _ladder(args, sidecar: PlanSidecar, where: str):
