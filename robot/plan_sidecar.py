@@ -167,6 +167,21 @@ def sidecar_path(traj_path: str | os.PathLike) -> Path:
     return p.with_name(p.name + ".plan.json")
 
 
+def segment_of_lines(sidecar: PlanSidecar, where: str) -> np.ndarray:
+    """The index of the segment each line (0-based) belongs to, shape (line_count,).
+
+    Raises:
+        InputError: a line no segment covers; ``where`` names the file.
+    """
+    index = np.full(sidecar.line_count, -1)
+    for k, seg in enumerate(sidecar.segments):
+        index[seg.first_line - 1:seg.last_line] = k
+    missing = np.flatnonzero(index < 0)
+    if len(missing):
+        raise InputError(f"{where}: field 'segments' does not cover line {missing[0] + 1}")
+    return index
+
+
 def check_line_count(traj_path: str | os.PathLike, lines: int, sidecar: PlanSidecar) -> None:
     """Refuse a trajectory of ``lines`` lines whose sidecar counts another number.
 

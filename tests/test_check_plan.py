@@ -165,7 +165,7 @@ def test_a_lone_compliant_hand_is_not_counted_on_for_balance():
     (`planner.statics.arm_capacity.balance_stance`), and reaches behind them with a rigid arm."""
     from ladders.geometry import LadderGeometry
     from ladders.loader import load_ladder
-    from planner.verify.check import _Verifier
+    from planner.verify.check import PlanVerifier
 
     spec = load_ladder("drc")
     p0, p1 = LadderGeometry(spec).rail_axis("right")
@@ -176,9 +176,9 @@ def test_a_lone_compliant_hand_is_not_counted_on_for_balance():
                        {**feet, "right_hand": HoldRecord("rail_right", tuple(hand))},
                        ("left_hand",))
     on_feet = Segment("dwell", "dwell", 0, 1, 1, feet, ())
-    region = {s: _Verifier(spec, "drc-hubo", s).stance(0, one_hand).region
+    region = {s: PlanVerifier(spec, "drc-hubo", s).stance(0, one_hand).region
               for s in ("mixed", "position")}
-    feet_region = _Verifier(spec, "drc-hubo", "mixed").stance(0, on_feet).region
+    feet_region = PlanVerifier(spec, "drc-hubo", "mixed").stance(0, on_feet).region
     np.testing.assert_allclose(region["mixed"].vertices, feet_region.vertices)
     behind = np.array([feet_region.vertices[:, 0].min() - 0.03, 0.0])
     assert region["mixed"].margin(behind) < 0 < region["position"].margin(behind)

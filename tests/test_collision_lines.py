@@ -16,7 +16,7 @@ sys.path.insert(0, str(Path(__file__).parent))
 from synthetic_plan import write_synthetic_plan  # noqa: E402
 
 from ladders.loader import load_ladder  # noqa: E402
-from planner.verify.check import _Verifier, allowed_contacts  # noqa: E402
+from planner.verify.check import PlanVerifier, allowed_contacts  # noqa: E402
 from planner.verify.collision_lines import CollisionLines, segment_distance  # noqa: E402
 from robot.joints import JOINT_INDEX  # noqa: E402
 from robot.plan_sidecar import read_sidecar, sidecar_path  # noqa: E402
@@ -47,7 +47,7 @@ def plan(tmp_path_factory):
 
 def test_flags_and_clearances_are_the_collision_models(plan):
     traj, side = plan
-    v = _Verifier(load_ladder("drc"), side.robot, "mixed")
+    v = PlanVerifier(load_ladder("drc"), side.robot, "mixed")
     lines = CollisionLines(v.collision)
     seg = side.segments[3]  # the rise, both feet on the floor
     rows = np.arange(seg.first_line - 1, seg.last_line)

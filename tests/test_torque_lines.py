@@ -16,7 +16,7 @@ from synthetic_plan import write_synthetic_plan  # noqa: E402
 from ladders.loader import load_ladder  # noqa: E402
 from planner.contacts import Stance  # noqa: E402
 from planner.statics.torque_lp import torque_feasibility  # noqa: E402
-from planner.verify.check import _Verifier  # noqa: E402
+from planner.verify.check import PlanVerifier  # noqa: E402
 from planner.verify.line_pass import _grip_use, _utilisation  # noqa: E402
 from planner.verify.torque_lines import StanceLines  # noqa: E402
 from robot.plan_sidecar import HoldRecord, read_sidecar, sidecar_path  # noqa: E402
@@ -34,7 +34,7 @@ def test_the_batch_lp_is_torque_feasibility_line_by_line(plan):
     the worst joint ratio and the grip's wrench on every line. (Which joint reaches the
     worst ratio is not the LP's to say: several do at its optimum.)"""
     traj, side = plan
-    v = _Verifier(load_ladder("drc"), side.robot, "mixed")
+    v = PlanVerifier(load_ladder("drc"), side.robot, "mixed")
     seg = side.segments[3]
     rows = np.arange(seg.first_line - 1, seg.last_line)
     poses, q = v.line_poses(traj[rows], seg)

@@ -59,7 +59,7 @@ from execute.play.player import PlayerTick, TrajectoryPlayer, min_jerk
 from ladders.geometry import LadderGeometry
 from ladders.spec import LadderSpec
 from robot.joints import ARM_JOINTS, FINGER_JOINTS, joint_indices
-from robot.plan_sidecar import PlanSidecar, Segment
+from robot.plan_sidecar import PlanSidecar, Segment, segment_of_lines
 
 __all__ = ["MotionLayer"]
 
@@ -143,10 +143,7 @@ class MotionLayer:
         self._last_now: float | None = None
         self.ladder = LadderEstimate(self.config.max_reach_correction_m,
                                      self.config.max_reach_correction_rad)
-        n = len(trajectory_rad)
-        self._segment_of_line = np.zeros(n, dtype=np.int32)
-        for k, seg in enumerate(sidecar.segments):
-            self._segment_of_line[seg.first_line - 1:seg.last_line] = k
+        self._segment_of_line = segment_of_lines(sidecar, "plan")
         self._next_hold = self._next_holds(sidecar.segments)
         self._finger_cols = {side: joint_indices(FINGER_JOINTS[side]) for side in SIDES}
         self._arm_cols = {side: joint_indices(ARM_JOINTS[side]) for side in SIDES}

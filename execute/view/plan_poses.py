@@ -1,7 +1,7 @@
 """The planned robot placed in the world, line by line, for display.
 
 The 40-column file has no base pose. check-plan's verifier places the body from a foot
-the sidecar says is held (`planner.verify.check._Verifier.line_poses`: the sole flat on
+the sidecar says is held (`planner.verify.check.PlanVerifier.line_poses`: the sole flat on
 its tread at the recorded hold); this module reuses it, then runs MuJoCo's forward
 kinematics on the scene the simulation steps (`ladders.scene.build_scene`), so that every
 body is where ``validate-plan``'s model would put it. The CoM and its stability margin
@@ -81,12 +81,13 @@ class PlanKinematics:
     def __init__(self, trajectory_rad: np.ndarray, sidecar: PlanSidecar, ladder: LadderSpec,
                  where: str = "plan"):
         from ladders.scene import build_scene
-        from planner.verify.check import _segment_of_lines, _Verifier
+        from planner.verify.check import PlanVerifier
+        from robot.plan_sidecar import segment_of_lines
 
         self.trajectory_rad = trajectory_rad
         self.sidecar = sidecar
-        self.segment_of_row = _segment_of_lines(sidecar, where)
-        self.verifier = _Verifier(ladder, sidecar.robot,
+        self.segment_of_row = segment_of_lines(sidecar, where)
+        self.verifier = PlanVerifier(ladder, sidecar.robot,
                                   sidecar.metrics.get("arm_strategy", "position"))
         self.model = build_scene(ladder, sidecar.robot).compile()
         addresses = joint_qpos_addresses(self.model)

@@ -33,8 +33,8 @@ from planner.statics.highs_lp import solve_lp
 from robot.errors import HuboLadderError
 from robot.vocabulary import Limb
 
-__all__ = ["GRIP_LOAD_COST", "OBJECTIVES", "TorqueCheck", "torque_feasibility",
-           "torque_limits_by_joint"]
+__all__ = ["GRIP_LOAD_COST", "OBJECTIVES", "TorqueCheck", "actuated_joints",
+           "torque_feasibility", "torque_limits_by_joint"]
 
 #: Cost of a hand's wrench in the torque LP, per unit of its use of the grip (each
 #: component as a share of its radial or bending capacity), against 1 per unit of the
@@ -127,7 +127,7 @@ class TorqueCheck:
                 f"{self.worst_joint}, {self.torque(self.worst_joint):+.1f} N·m; {loads}{grip})")
 
 
-#: `_actuated` per model and limits: (model, result), keyed by the model's id and the
+#: `actuated_joints` per model and limits: (model, result), keyed by the model's id and the
 #: limits' items. The torque LP runs ~13,000 times a rung on a handful of limit tables,
 #: and walking the model's joints took a tenth of its time.
 _ACTUATED: dict[tuple[int, frozenset], tuple[object, tuple]] = {}
@@ -143,7 +143,7 @@ def _cross_rows(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return out
 
 
-def _actuated(model, torque_max_nm_by_joint: Mapping[str, float]):
+def actuated_joints(model, torque_max_nm_by_joint: Mapping[str, float]):
     """Names, velocity indices, limits of the model's actuated (1-dof) joints and the
     model's weight [N] (memoised per model and limits)."""
     key = (id(model), frozenset(torque_max_nm_by_joint.items()))
@@ -222,7 +222,7 @@ def torque_feasibility(model, data, q: np.ndarray, stance: Stance,
     if objective not in OBJECTIVES:
         raise ValueError(f"unknown objective {objective!r}; use one of {OBJECTIVES}")
     cfg = config or default_config()
-    names, v_idx, tmax, weight_n = _actuated(model, torque_max_nm_by_joint)
+    names, v_idx, tmax, weight_n = actuated_joints(model, torque_max_nm_by_joint)
 
     pin.computeJointJacobians(model, data, q)
     pin.updateFramePlacements(model, data)

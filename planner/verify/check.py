@@ -33,7 +33,7 @@ its tread (the planner keeps a friction share and a centre-of-pressure margin).
 
 Size: the checks run in one pass over the lines (`check_plan`), a batch of one segment's
 lines at a time (`planner.verify.line_pass`); this module keeps what the pass shares:
-the results, the contact rules and models, and `_Verifier`, the robot and ladder models
+the results, the contact rules and models, and `PlanVerifier`, the robot and ladder models
 the lines are checked on.
 """
 
@@ -53,7 +53,7 @@ from ladders.contact_model import hand_limits, sole_patch_x
 from planner.holds import foot_patch, half_tread_m
 from planner.statics.arm_capacity import balance_stance, gripping_sides, gripping_torque_limits
 from robot.errors import InputError
-from robot.plan_sidecar import PlanSidecar, Segment
+from robot.plan_sidecar import PlanSidecar, Segment, segment_of_lines
 from robot.vocabulary import HoldTarget, HoldTargetKind, Limb
 
 if TYPE_CHECKING:
@@ -62,7 +62,7 @@ if TYPE_CHECKING:
     from planner.statics.torque_lp import TorqueCheck
 
 __all__ = ["CHECKS", "CLEARANCE_EVERY_LINES", "CheckResult", "ContactLoad", "HOLD_TOL_M",
-           "PlannedLoad",
+           "PlanVerifier", "PlannedLoad",
            "allowed_contacts", "check_plan", "contact_hold", "contact_wrench_utilisation",
            "planned_loads"]
 
@@ -233,7 +233,7 @@ def _grip_clause(limb: str, load: str, use: float, force: np.ndarray, torque: np
 
 
 class _SegmentStance(NamedTuple):
-    """A segment's holds as the checks use them (`_Verifier.stance`)."""
+    """A segment's holds as the checks use them (`PlanVerifier.stance`)."""
 
     stance: Stance
     region: SupportRegion  # the CoM's, on the holds that may balance it
@@ -241,7 +241,7 @@ class _SegmentStance(NamedTuple):
     balance_limbs: tuple[str, ...]  # those holds (`planner.statics.arm_capacity.balance_stance`)
 
 
-class _Verifier:
+class PlanVerifier:
     """The robot and ladder models the checks run on."""
 
     def __init__(self, spec, robot: str, arm_strategy: str):
@@ -413,16 +413,6 @@ def _holds_key(holds: dict) -> tuple:
     return tuple(sorted((lb, h.target, tuple(h.position_m)) for lb, h in holds.items()))
 
 
-def _segment_of_lines(sidecar: PlanSidecar, where: str) -> np.ndarray:
-    index = np.full(sidecar.line_count, -1)
-    for k, seg in enumerate(sidecar.segments):
-        index[seg.first_line - 1:seg.last_line] = k
-    missing = np.flatnonzero(index < 0)
-    if len(missing):
-        raise InputError(f"{where}: field 'segments' does not cover line {missing[0] + 1}")
-    return index
-
-
 @dataclass(frozen=True, eq=False)
 class PlannedLoad:
     """The plan's account of one line: where the body is and how it carries its weight.
@@ -446,8 +436,8 @@ def planned_loads(traj_rad: np.ndarray, sidecar: PlanSidecar, spec, lines: Seque
     computes them: what a simulation of the plan is compared against."""
     from planner.statics.torque_lp import torque_feasibility
 
-    seg_of = _segment_of_lines(sidecar, "plan")
-    v = _Verifier(spec, robot or sidecar.robot, sidecar.metrics.get("arm_strategy",
+    seg_of = segment_of_lines(sidecar, "plan")
+    v = PlanVerifier(spec, robot or sidecar.robot, sidecar.metrics.get("arm_strategy",
                                                                      "position"))
     out = []
     for line in lines:
@@ -502,9 +492,9 @@ def check_plan(traj_rad: np.ndarray, sidecar: PlanSidecar, spec, robot: str | No
     if n != sidecar.line_count:
         raise InputError(f"{where}: the trajectory has {n} lines, its sidecar's field "
                          f"'line_count' says {sidecar.line_count}")
-    seg_of = _segment_of_lines(sidecar, where)
+    seg_of = segment_of_lines(sidecar, where)
     segs = sidecar.segments
-    v = _Verifier(spec, robot, arm_strategy)
+    v = PlanVerifier(spec, robot, arm_strategy)
     res = _new_results()
     _check_limits_and_speed(res, traj_rad, joint_limits(robot), rate_hz)
 

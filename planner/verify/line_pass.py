@@ -23,7 +23,7 @@ from robot.plan_sidecar import Segment
 if TYPE_CHECKING:
     from planner.contacts import Hold
     from planner.verify.batch_kinematics import JointPoses
-    from planner.verify.check import CheckResult, _Verifier
+    from planner.verify.check import CheckResult, PlanVerifier
     from planner.verify.torque_lines import LineTorques
 
 __all__ = ["check_lines", "offer_lines"]
@@ -53,7 +53,7 @@ def offer_lines(result: CheckResult, lines: np.ndarray, keys: np.ndarray,
     result.ok &= n_failed == 0
 
 
-def check_lines(res: dict[str, CheckResult], v: _Verifier, traj_rad: np.ndarray,
+def check_lines(res: dict[str, CheckResult], v: PlanVerifier, traj_rad: np.ndarray,
                 segs: Sequence[Segment], si: int, rows: np.ndarray, every: int) -> None:
     """Every check on lines ``rows`` (0-based, consecutive) of segment ``si``.
 
@@ -97,7 +97,7 @@ def check_lines(res: dict[str, CheckResult], v: _Verifier, traj_rad: np.ndarray,
         _check_loads(res, v, lp, q.subset(idx[ok]), lines[idx[ok]], si, seg, label)
 
 
-def _check_holds(result: CheckResult, v: _Verifier, poses: JointPoses, lines: np.ndarray,
+def _check_holds(result: CheckResult, v: PlanVerifier, poses: JointPoses, lines: np.ndarray,
                  seg: Segment, label: str) -> None:
     """Every limb the segment holds: its frame at its hold, and the hold on its object."""
     limbs = list(seg.holds)
@@ -123,7 +123,7 @@ def _check_holds(result: CheckResult, v: _Verifier, poses: JointPoses, lines: np
     offer_lines(result, lines, worst, worst, worst > HOLD_TOL_M, detail)
 
 
-def _check_collisions(result: CheckResult, v: _Verifier, poses: JointPoses, q,
+def _check_collisions(result: CheckResult, v: PlanVerifier, poses: JointPoses, q,
                       lines: np.ndarray, segs: Sequence[Segment], si: int, label: str) -> None:
     """Collisions on every line, the clearance on every `CLEARANCE_EVERY_LINES`-th line
     and on every line that collides; a moving limb may touch what it leaves in the first
@@ -149,7 +149,7 @@ def _check_collisions(result: CheckResult, v: _Verifier, poses: JointPoses, q,
                 lambda i: f"{label}: {pair.get(int(shown[i])) or 'in collision'}")
 
 
-def _check_loads(res: dict[str, CheckResult], v: _Verifier, lp: LineTorques, q,
+def _check_loads(res: dict[str, CheckResult], v: PlanVerifier, lp: LineTorques, q,
                  lines: np.ndarray, si: int, seg: Segment, label: str) -> None:
     """The torque ratio, and every grip's use of its limits: the torque LP's own wrenches
     where it is feasible, else the least use any load share within the joints needs

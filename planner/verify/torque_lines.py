@@ -40,7 +40,7 @@ from ladders.contact_model import HandLimits
 from planner.statics.config import StabilityConfig, StabilityError, default_config
 from planner.statics.contact_wrenches import cone_edges_cached, grip_rows, split_wrench_basis
 from planner.statics.highs_lp import dense_lp, quiet_highs
-from planner.statics.torque_lp import GRIP_LOAD_COST, _actuated
+from planner.statics.torque_lp import GRIP_LOAD_COST, actuated_joints
 from planner.verify.batch_kinematics import BatchKinematics, JointPoses
 
 __all__ = ["BASIS_TOL", "LineTorques", "StanceLines"]
@@ -143,7 +143,7 @@ class StanceLines:
         self.kin = kin
         # The actuated joints, their velocity indices and limits, and the weight [N]:
         # `torque_feasibility`'s.
-        self.joint_names, self.v_idx, self.tmax, self.weight_n = _actuated(
+        self.joint_names, self.v_idx, self.tmax, self.weight_n = actuated_joints(
             model, torque_max_nm_by_joint)
         self.holds: list[_Hold] = []
         starts, costs, grips = [0], [], []
