@@ -11,10 +11,11 @@ from robot.joints import JOINT_NAMES
 from robot.kinematic_tree import build_tree
 from robot.params import RobotParams, robot_params
 
-#: How far beyond a joint limit a value still counts as on it [rad]: the float slack of
-#: values written by a formatter. The trajectory reader accepts such values and the
-#: daemon clamps them; anything farther is refused (reader) or rejected (daemon).
-LIMIT_TOLERANCE_RAD = 1e-9
+#: How far beyond a joint limit a value still counts as on it [rad]: the rounding of a
+#: trajectory file's values to a microradian (`robot.trajectory_file.DECIMALS`). The
+#: trajectory reader accepts such values and the daemon clamps them; anything farther is
+#: refused (reader) or rejected (daemon).
+LIMIT_TOLERANCE_RAD = 1e-6
 #: How far past a joint limit the daemon still clamps a commanded reference onto it [rad];
 #: farther, it rejects the reference (the joint holds its previous one). Writers that
 #: compute references (the motion layer's corrections) land up to about 2e-6 rad past a

@@ -7,10 +7,10 @@ report every problem as ``file:line:column: message``.
 
 A name ending in ``.gz`` (``climb.traj.gz``) is the same text gzip-compressed: every
 reader and writer here handles it, so every command that takes a ``.traj`` takes a
-``.traj.gz``. Values are written rounded to `DECIMALS` places (a nanoradian, four orders
-below the encoders' resolution): the full 17 digits of a float are noise that neither
-the robot nor gzip can use. A DRC climb of 314,000 lines at 200 Hz is 226 MB with 17
-digits (gzip makes it 71 MB), 123 MB rounded, and 39 MB rounded and gzipped.
+``.traj.gz``. Values are written rounded to `DECIMALS` places (a microradian, ten times
+finer than the encoders resolve): the full 17 digits of a float are noise that neither
+the robot nor gzip can use. A DRC climb of 300,000 lines at 200 Hz is about 220 MB with
+17 digits (gzip makes it 71 MB); rounded to 6 places and gzipped it is 25 MB (37 MB at 9).
 """
 
 from __future__ import annotations
@@ -50,9 +50,10 @@ MAX_LINE_CHARS = 998
 #: The largest ``--clamp-limits`` tolerance [rad]: files of the original player overshoot
 #: the knee's lower limit by up to 0.07 rad; a larger tolerance would hide real errors.
 MAX_CLAMP_TOLERANCE_RAD = 0.1
-#: Decimal places written [rad]: the rounding error (at most 5e-10 rad) stays within
-#: ``LIMIT_TOLERANCE_RAD`` of a value on a limit; the Hubo encoders resolve about 1e-5 rad.
-DECIMALS = 9
+#: Decimal places written [rad]: a microradian, ten times finer than the Hubo encoders
+#: resolve (about 1e-5 rad); the rounding error (at most 5e-7 rad) stays within
+#: ``LIMIT_TOLERANCE_RAD`` of a value on a limit.
+DECIMALS = 6
 #: gzip's level for ``.traj.gz``: 6 (gzip's default) 5.84x on a DRC climb in 1.5 s per
 #: 30,000 lines, level 9 hardly smaller at twice the time.
 GZIP_LEVEL = 6
@@ -133,7 +134,7 @@ def format_trajectory(q_rad: np.ndarray) -> str:
 
 def write_trajectory(path: str | os.PathLike, q_rad: np.ndarray) -> None:
     """Write ``q_rad`` (N, 40) so that hubo-read-trajectory and ``read_trajectory`` read it
-    back to within half a nanoradian (`DECIMALS`), and what was read writes back bit for
+    back to within half a microradian (`DECIMALS`), and what was read writes back bit for
     bit. Written to a temporary file and renamed, so a crash leaves no half file.
     A name ending in ``.gz`` is written gzip-compressed (no name or time in the header, so
     the same trajectory gives the same bytes); ``gunzip`` gives the plain file.

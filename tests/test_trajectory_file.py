@@ -7,6 +7,7 @@ from robot.errors import InputError, TrajectoryFileError
 from robot.joints import JOINT_INDEX, JOINT_NAMES
 from robot.limits import joint_limits
 from robot.trajectory_file import (
+    DECIMALS,
     format_clamps,
     format_trajectory,
     read_trajectory,
@@ -37,7 +38,7 @@ def _fail(path, rate=25.0):
 
 
 @pytest.mark.parametrize("name", ["climb.traj", "climb.traj.gz"])
-def test_round_trip_is_within_a_nanoradian_then_exact(tmp_path, name):
+def test_round_trip_is_within_a_microradian_then_exact(tmp_path, name):
     q = _smooth_trajectory()
     q[3, 5] += 1 / 3000  # a value with no short decimal form
     q[4, 6] = -1e-13  # rounds to 0, written "0.0" (not "-0.0")
@@ -45,12 +46,12 @@ def test_round_trip_is_within_a_nanoradian_then_exact(tmp_path, name):
     write_trajectory(path, q)
     back = read_trajectory(path, 25.0)
     assert back.shape == (50, 40)
-    assert np.abs(back - q).max() <= 0.5e-9
-    assert np.array_equal(back, np.round(q, 9) + 0.0)
+    assert np.abs(back - q).max() <= 0.5e-6
+    assert np.array_equal(back, np.round(q, DECIMALS) + 0.0)
     again = tmp_path / ("again-" + name)
     write_trajectory(again, back)
     assert again.read_bytes() == path.read_bytes()  # what was read writes back bit for bit
-    assert max(len(v.split(".")[-1]) for v in format_trajectory(q).split()) <= 9
+    assert max(len(v.split(".")[-1]) for v in format_trajectory(q).split()) <= DECIMALS
 
 
 @pytest.mark.parametrize("text", ["plain", "tabs and 17 digits", "crlf", "last line bare"])
@@ -177,7 +178,7 @@ def test_values_past_a_limit_are_read_as_they_are_without_the_limit_check(monkey
     write_trajectory(path, q)
     assert "(LKN)" in _fail(path)
     at_once = read_trajectory(path, 25.0, check_speed=False, check_limits=False)
-    assert np.array_equal(at_once, np.round(q, 9) + 0.0)
+    assert np.array_equal(at_once, np.round(q, DECIMALS) + 0.0)
     monkeypatch.setattr(tf, "_parse_plain", lambda *args: None)
     assert np.array_equal(at_once, read_trajectory(path, 25.0, check_speed=False,
                                                    check_limits=False))

@@ -280,6 +280,15 @@ def test_validate_plan_refuses_a_bad_record_path_before_simulating(plan, tmp_pat
     assert "run.mp4: a recording is written as a .rrd file" in err
 
 
+@pytest.mark.parametrize("hz", ["0", "500"])
+def test_validate_plan_refuses_a_record_rate_out_of_range_before_simulating(plan, tmp_path,
+                                                                             capsys, hz):
+    err = _bad([str(plan[0]), "--record", str(tmp_path / "run.rrd"), "--record-hz", hz],
+               capsys, validate_main)
+    assert f"--record-hz {hz}: choose a rate within [0.1, 200] Hz" in err
+    assert not (tmp_path / "run.rrd").exists()
+
+
 @pytest.mark.skipif(not list(Path("/usr/share/vulkan/icd.d").glob("*.json")),
                     reason="no Vulkan driver for a headless viewer (Debian: "
                            "mesa-vulkan-drivers)")

@@ -4,6 +4,7 @@
                   [--placement-error dx,dy,dyaw] [--json R.json] [--video V.mp4]
                   [--plots DIR] [--robot R] [--open-loop] [--max-reach-correction M]
                   [--grasp-retries N] [--holding-arm-stiffness S] [--record R.rrd]
+                  [--record-hz HZ]
 
 Reads ``PLAN.traj`` and its sidecar ``PLAN.plan.json`` (rate, holds, arm schedule,
 ladder), runs `execute.validate.simulate.simulate`, prints the verdict and the metrics, and
@@ -60,6 +61,9 @@ def _parser() -> argparse.ArgumentParser:
                    help="write a Rerun recording of the run (the simulated robot beside the "
                         "plan's ghost, events, joint series): rerun R.rrd opens it "
                         "(docs/viewer.md)")
+    p.add_argument("--record-hz", type=float, default=20.0, metavar="HZ",
+                   help="with --record: robot poses drawn per simulated second, within "
+                        "[0.1, 200] (default 20; a whole DRC climb is about 6 MB per Hz)")
     p.add_argument("--robot", default=None, help="robot (default: the sidecar's)")
     p.add_argument("-v", "--verbose", action="store_true", help="log events as they happen")
     return p
@@ -190,12 +194,14 @@ def _run(args: argparse.Namespace) -> int:
     from execute.validate.metrics import compute_metrics
     from execute.validate.plan_compare import compare_with_plan
     from execute.validate.simulate import SimulationOptions, simulate
+    from execute.view.cli import display_every_s
     from ladders.loader import load_ladder
     from robot.plan_sidecar import check_line_count, read_sidecar, sidecar_path
     from robot.progress import ProgressReporter
     from robot.trajectory_file import read_trajectory
 
     plan = Path(args.plan)
+    record_every_s = display_every_s("--record-hz", args.record_hz)
     if args.record:
         from execute.view.output import check_output
 
@@ -230,9 +236,11 @@ def _run(args: argparse.Namespace) -> int:
     if args.json:
         Path(args.json).write_text(json.dumps(result, indent=1))
     if args.record:
+        from execute.view.plan_layers import PlanLayers
         from execute.view.run_recording import write_run_recording
 
-        print(f"wrote {write_run_recording(run, traj, ladder, args.record)}")
+        layers = PlanLayers(display_every_s=record_every_s)
+        print(f"wrote {write_run_recording(run, traj, ladder, args.record, layers)}")
     if args.plots or args.video:
         from execute.validate.artifacts import (
             RenderingUnavailable,

@@ -27,7 +27,7 @@ from pathlib import Path
 
 from robot.errors import InputError, run_cli
 
-__all__ = ["default_output", "main"]
+__all__ = ["default_output", "display_every_s", "main"]
 
 log = logging.getLogger("hubo-view")
 
@@ -93,20 +93,26 @@ def default_output(path: Path) -> Path:
     return path.with_name(name.removesuffix(".json") + ".rrd")
 
 
+def display_every_s(flag: str, hz: float) -> float:
+    """The spacing [s] of drawn robot poses for a display rate ``hz`` given as ``flag``;
+    refused outside `DISPLAY_HZ_RANGE`."""
+    lo, hi = DISPLAY_HZ_RANGE
+    if not lo <= hz <= hi:
+        raise InputError(f"{flag} {hz:g}: choose a rate within [{lo:g}, {hi:g}] Hz")
+    return 1.0 / hz
+
+
 def _layers(args: argparse.Namespace):
     from execute.view.plan_layers import PlanLayers
     from execute.view.plan_statics import FORCE_EVERY_S
 
-    lo, hi = DISPLAY_HZ_RANGE
-    if not lo <= args.display_hz <= hi:
-        raise InputError(f"--display-hz {args.display_hz:g}: choose a rate within "
-                         f"[{lo:g}, {hi:g}] Hz")
+    display_s = display_every_s("--display-hz", args.display_hz)
     every = FORCE_EVERY_S if args.force_every is None else args.force_every
     lo, hi = FORCE_EVERY_RANGE_S
     if not lo <= every <= hi:
         raise InputError(f"--force-every {every:g}: choose a spacing within [{lo:g}, "
                          f"{hi:g}] s")
-    return PlanLayers(display_every_s=1.0 / args.display_hz, statics=not args.no_statics,
+    return PlanLayers(display_every_s=display_s, statics=not args.no_statics,
                       force_every_s=every)
 
 
