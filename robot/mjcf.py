@@ -53,11 +53,6 @@ def _add_geom(body, g: Geom, classname, rgba) -> None:
     geom.rgba = rgba
 
 
-#: MuJoCo's ``impratio``: friction constraints this many times harder than normal ones
-#: (MuJoCo Menagerie's quadruped models use 100 against foot slip).
-FRICTION_IMPEDANCE_RATIO = 100.0
-
-
 def new_spec(timestep_s: float = PHYSICS_DT_S) -> mujoco.MjSpec:
     """An empty spec with this project's physics options and default classes."""
     spec = mujoco.MjSpec()
@@ -65,13 +60,9 @@ def new_spec(timestep_s: float = PHYSICS_DT_S) -> mujoco.MjSpec:
     spec.compiler.autolimits = True
     spec.option.timestep = timestep_s
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
-    # Elliptic cones, and friction 100 times harder than the normal contact: MuJoCo's soft
-    # friction carries a steady tangential load only while it slips at a speed that grows
-    # with its softness, so at impratio 10 a stance sole crept 1.3 cm forward on its rung
-    # during one swing at 0.3 of μ; real static friction does not creep inside its cone.
-    # The cone's limit is unchanged (docs/decisions/friction-impedance.md).
+    # Elliptic cones and a high impratio keep friction grasps and footholds from creeping.
     spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
-    spec.option.impratio = FRICTION_IMPEDANCE_RATIO
+    spec.option.impratio = 10.0
     visual = spec.add_default("visual", spec.default)
     visual.geom.contype = 0
     visual.geom.conaffinity = 0
@@ -171,5 +162,5 @@ def joint_qpos_addresses(model: mujoco.MjModel) -> dict[str, int]:
     return out
 
 
-__all__ = ["FRICTION_IMPEDANCE_RATIO", "ROOT_LINK", "actuated_columns", "add_floor", "add_robot", "joint_qpos_addresses",
+__all__ = ["ROOT_LINK", "actuated_columns", "add_floor", "add_robot", "joint_qpos_addresses",
            "new_spec", "position_gains", "robot_spec"]

@@ -16,7 +16,6 @@ class MotionEventKind(enum.Enum):
     ARRIVAL_WAIT = "arrival wait"  #: a hand lagged its reference; the grasp waited for it
     STIFF_REACH = "stiff reach"  #: a compliant arm short of its hold finished in position mode
     LADDER_ESTIMATE = "ladder estimate"  #: the estimate of the ladder's pose changed
-    JOINT_RELIEF = "joint relief"  #: a rigid joint at its limit in a closed chain gave way
     STOP = "stop"  #: the layer holds the pose and stops the climb
 
 

@@ -20,9 +20,8 @@ hubo-motion-rt and the thesis's operator did (thesis §4.3.4, §6.2):
   closes again, up to ``grasp_retries`` times. If it still holds nothing
   the layer **stops**: the player stays paused, every verified grip is kept, and the
   climb ends with the reason. The weight never moves onto an unverified grasp;
-- **joint relief** (`execute.motion.joint_relief`): the wrist roll of a gripping compliant
-  arm, and the joints of a standing leg, give way while their motor currents say a closed
-  chain loads them towards their limits;
+- **wrist-roll relief** of a gripping compliant arm (`execute.motion.wrist_relief`), from
+  its motor current;
 - **reach correction**: every verified grasp measures where its rail is
   (`execute.motion.ladder_estimate`); every later reach of a hand or a foot to a hold on
   the ladder is re-targeted by that estimate, by inverse kinematics on the limb's chain
@@ -52,21 +51,14 @@ from execute.motion.events import MotionEvent, MotionEventKind, MotionStop
 from execute.motion.gains import motion_pwm_gains
 from execute.motion.grasp_check import GraspReading, read_grasp
 from execute.motion.gravity_compensation import ArmGravityCompensation
-from execute.motion.joint_relief import (
-    LEG_RELIEF,
-    WRIST_RELIEF,
-    WRIST_ROLL,
-    JointRelief,
-    ReliefRule,
-    leg_columns,
-)
 from execute.motion.ladder_estimate import LadderEstimate, RailObservation
 from execute.motion.robot_model import MotionRobotModel
 from execute.motion.sensed_state import SensedState
+from execute.motion.wrist_relief import WRIST_ROLL, WristRelief
 from execute.play.player import PlayerTick, TrajectoryPlayer, min_jerk
 from ladders.geometry import LadderGeometry
 from ladders.spec import LadderSpec
-from robot.joints import ARM_JOINTS, FINGER_JOINTS, JOINT_NAMES, joint_indices
+from robot.joints import ARM_JOINTS, FINGER_JOINTS, joint_indices
 from robot.plan_sidecar import PlanSidecar, Segment, segment_of_lines
 
 __all__ = ["MotionLayer"]
@@ -145,7 +137,7 @@ class MotionLayer:
                  if limb.endswith("_foot")}
         self.estimator = StateEstimator(self.model, soles, self.config.estimator)
         self.gravity = ArmGravityCompensation(self.model)
-        self.relief = JointRelief(robot)
+        self.wrist_relief = WristRelief(robot)
         #: The gains the daemon should run the compliant arms with (`execute.motion.gains`).
         self.pwm_gains = motion_pwm_gains()
         self._last_now: float | None = None
@@ -155,7 +147,6 @@ class MotionLayer:
         self._next_hold = self._next_holds(sidecar.segments)
         self._finger_cols = {side: joint_indices(FINGER_JOINTS[side]) for side in SIDES}
         self._arm_cols = {side: joint_indices(ARM_JOINTS[side]) for side in SIDES}
-        self._leg_cols = {side: leg_columns(side) for side in SIDES}
         self._offsets: dict[str, _Blend] = {}
         self._shift_m: dict[str, np.ndarray] = {}  # limb → world shift its offset makes [m]
         self._segment = -1
@@ -484,11 +475,7 @@ class MotionLayer:
             gripping = (hold is not None and hold.target.startswith("rail")
                         and bool(tick.comply[cols].all()))
             wrist_roll = WRIST_ROLL[side]
-            ref[wrist_roll] += self._relieve(wrist_roll, WRIST_RELIEF, gripping, s, dt,
-                                             f"{side}_hand")
-            standing = f"{side}_foot" in seg.holds
-            for col in self._leg_cols[side]:
-                ref[col] += self._relieve(col, LEG_RELIEF, standing, s, dt, f"{side}_foot")
+            ref[wrist_roll] += self.wrist_relief.update(wrist_roll, gripping, s.cur_a, dt)
             share = self.config.holding_arm_stiffness
             if gripping and share < 1.0:
                 soft = [c for c in cols if c != wrist_roll]
@@ -508,21 +495,6 @@ class MotionLayer:
             ff = np.where(comply, ff, 0.0)  # feed-forward acts only on compliant joints
         return dataclasses.replace(tick, ref_rad=ref, mode=mode, comply=comply,
                                    feedforward_nm=ff)
-
-    def _relieve(self, col: int, rule: ReliefRule, holding: bool, s: SensedState,
-                 dt_s: float, limb: str) -> float:
-        """Column ``col``'s relief offset this tick [rad]; the first tick it gives way in
-        a hold is an event."""
-        before = self.relief.offset_rad.get(col, 0.0)
-        off = self.relief.update(col, rule, holding, s.cur_a, dt_s)
-        if before == 0.0 and off != 0.0 and holding:
-            name = JOINT_NAMES[col]
-            torque = self.relief.torque_nm(col, s.cur_a)
-            self._event(MotionEventKind.JOINT_RELIEF, limb, 0.0,
-                        f"{name} pushes {torque:+.1f} N·m, over {rule.torque_share:g} of its "
-                        f"{self.relief.limit_nm[col]:.1f} N·m limit: its reference gives way "
-                        f"(at most {rule.max_offset_rad:g} rad)")
-        return off
 
     # ------------------------------------------------------------------ report
     def report(self) -> dict:

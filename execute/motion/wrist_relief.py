@@ -1,0 +1,59 @@
+"""Relief of a gripping compliant arm's wrist roll, the one joint of the arm that cannot
+comply (it shares a 3-channel board with the fingers, hubo-facts §2).
+
+With the hand closed on its rail, a twist of the grip loads its position loop; when its
+board trips, the fingers let go. The motor current says how hard a joint pushes (``τ =
+η·gear·Kt·I``, `robot.motors`). While that torque is above ``relief_fraction`` of the
+joint's limit, its reference walks towards where the grip wants it, at
+``relief_speed_rad_s``, within ``max_offset_rad``; the offset is kept while the hand
+holds and unwound while it moves in the air.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from robot.joints import JOINT_INDEX
+from robot.limits import joint_limits
+from robot.motors import MotorTable, motor_table
+
+__all__ = ["WRIST_ROLL", "WristRelief"]
+
+WRIST_ROLL = {"left": JOINT_INDEX["LWR"], "right": JOINT_INDEX["RWR"]}
+
+
+class WristRelief:
+    """Offsets of rigid joints from their sensed motor currents (module docstring).
+
+    Args:
+        robot: robot name (torque limits).
+        relief_fraction: share of the torque limit above which the reference gives way.
+        relief_speed_rad_s: how fast it gives way [rad/s].
+        max_offset_rad: largest offset [rad].
+    """
+
+    def __init__(self, robot: str = "drc-hubo", relief_fraction: float = 0.5,
+                 relief_speed_rad_s: float = 0.3, max_offset_rad: float = 0.6,
+                 motors: MotorTable | None = None):
+        self.limit_nm = joint_limits(robot).torque_max_nm
+        self.motors = motors or motor_table()
+        self.relief_fraction = relief_fraction
+        self.speed = relief_speed_rad_s
+        self.max_offset_rad = max_offset_rad
+        self.offset_rad: dict[int, float] = {}
+
+    def update(self, joint: int, holding: bool, cur_a: np.ndarray, dt_s: float) -> float:
+        """The offset of column ``joint`` after one tick [rad]."""
+        j = joint
+        off = self.offset_rad.get(j, 0.0)
+        if holding:
+            torque = float(cur_a[j] * self.motors.efficiency[j] * self.motors.gear[j]
+                           * self.motors.kt_nm_per_a[j])
+            if abs(torque) > self.relief_fraction * self.limit_nm[j]:
+                # the loop pushes with +τ towards a reference above the joint: give way
+                off -= np.sign(torque) * self.speed * dt_s
+        else:
+            off -= np.sign(off) * min(abs(off), self.speed * dt_s)
+        off = float(np.clip(off, -self.max_offset_rad, self.max_offset_rad))
+        self.offset_rad[j] = off
+        return off
