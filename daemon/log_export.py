@@ -57,6 +57,7 @@ from daemon.structs import FT_NAMES, IMU_NAMES, NUM_FT, NUM_IMU
 from robot.constants import DAEMON_RATE_HZ
 from robot.errors import HuboLadderError, InputError, run_cli
 from robot.joints import JOINT_NAMES, NUM_JOINTS
+from robot.output_path import writable_output
 
 __all__ = ["ExportResult", "export_mcap", "main", "msgdef"]
 
@@ -158,12 +159,7 @@ def require_mcap() -> None:
 def check_output(path: str | os.PathLike, log_path: str | os.PathLike) -> Path:
     """``path`` if an MCAP file can be written there: a ``.mcap`` name, in a folder that
     exists, not the log itself."""
-    out = Path(path)
-    if out.suffix != ".mcap":
-        raise InputError(f"{out}: the export is an MCAP file; name it "
-                         f"{out.with_suffix('.mcap').name}")
-    if not out.parent.is_dir():
-        raise InputError(f"{out}: no folder {out.parent} to write the MCAP file in")
+    out = writable_output(path, ".mcap", "the MCAP export")
     if out.exists() and out.resolve() == Path(log_path).resolve():
         raise InputError(f"{out}: is the log being exported; name another file")
     return out

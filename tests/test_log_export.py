@@ -201,7 +201,7 @@ def _no_pos(tmp_path: Path) -> Path:
     (_empty, "out.mcap", None, "empty.hlog: has no complete record"),
     (_no_pos, "out.mcap", None, "nopos.hlog: no 'pos' field"),
     (lambda p: write_log(p / "ok.hlog", synthetic_records(5)), "out.bag", None,
-     "out.bag: the export is an MCAP file; name it out.mcap"),
+     "out.bag: the MCAP export is written as a .mcap file; name it out.mcap"),
     (lambda p: write_log(p / "ok.hlog", synthetic_records(5)), "out.mcap", 500.0,
      "--rate 500: must be in (0, 200] Hz"),
     (lambda p: write_log(p / "ok.hlog", synthetic_records(5)), "out.mcap", 0.0,

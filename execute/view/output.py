@@ -16,7 +16,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 from urllib.parse import quote
 
-from robot.errors import HuboLadderError, InputError
+from robot.errors import HuboLadderError
+from robot.output_path import writable_output
 
 if TYPE_CHECKING:
     import rerun as rr
@@ -40,13 +41,7 @@ def check_output(path: str | Path) -> Path:
     """``path`` if a recording can be written there: Rerun installed, a ``.rrd`` name in
     a folder that exists (checked before a long run, not after)."""
     require_rerun()
-    out = Path(path)
-    if out.suffix != ".rrd":
-        raise InputError(f"{out}: a recording is written as a .rrd file; name it "
-                         f"{out.with_suffix('.rrd').name}")
-    if not out.parent.is_dir():
-        raise InputError(f"{out}: no folder {out.parent} to write the recording in")
-    return out
+    return writable_output(path, ".rrd", "a recording")
 
 
 def _stream() -> rr.RecordingStream:
