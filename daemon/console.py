@@ -42,7 +42,7 @@ import numpy as np
 
 from robot.errors import HuboLadderError, InputError, parse_finite, run_cli
 
-__all__ = ["Console", "main"]
+__all__ = ["Console", "add_daemon_options", "main"]
 
 ACK_TIMEOUT_S = 1.0  # wait at most this for the daemon to tick past a command [s]
 _GAIN_COMMANDS = {"kp": ("kp", 0), "kd": ("kd", 1), "maxpwm": ("max_pwm_pct", 2)}
@@ -92,13 +92,25 @@ class Console:
         for c in (self.cmd, self.ref, self.state):
             c.close()
 
-    def _state(self) -> np.ndarray:
+    def state_now(self) -> np.ndarray:
+        """The daemon's newest state sample.
+
+        Raises:
+            HuboLadderError: no sample, or the newest is over 0.5 s old (no daemon ticks).
+        """
         s = self.state.read_latest()
         if s is None or time.monotonic_ns() - int(s["time_ns"]) > 500_000_000:
             raise HuboLadderError(f"no hubo-daemon is ticking on instance {self.instance!r}")
         return s
 
-    def _wait_ticks(self, since: np.ndarray, ticks: int = 2) -> None:
+    def wait_ticks(self, since: np.ndarray, ticks: int = 2) -> None:
+        """Wait until the daemon has ticked ``ticks`` times past the state sample ``since``,
+        so a command written after ``since`` has been seen (latest-value channels keep only
+        the newest sample).
+
+        Raises:
+            HuboLadderError: it did not within `ACK_TIMEOUT_S`.
+        """
         target = int(since["tick"]) + ticks
         deadline = time.monotonic() + ACK_TIMEOUT_S
         s = since
@@ -113,20 +125,20 @@ class Console:
         """Send one board command and wait until the daemon has seen it."""
         from daemon.structs import BOARD_CMD_DTYPE, new_sample
 
-        before = self._state()
+        before = self.state_now()
         c = new_sample(BOARD_CMD_DTYPE)
         c["type"], c["joint"] = int(kind), joint
         c["params"][: len(params)] = params
         c["dvalues"][: len(dvalues)] = dvalues
         self.cmd.write(c)
-        self._wait_ticks(before)
+        self.wait_ticks(before)
 
     def reference(self, joint: int, rad: float, comply: bool) -> None:
         """Command one joint to ``rad`` [rad], every other joint where it is."""
         from daemon.control_modes import RefMode
         from daemon.structs import REF_DTYPE, new_sample
 
-        before = self._state()
+        before = self.state_now()
         r = new_sample(REF_DTYPE)
         r["ref"] = before["ref"]
         r["comply"] = before["comply"]
@@ -135,7 +147,7 @@ class Console:
         r["comply"][joint] = comply
         r["playing"] = 0
         self.ref.write(r)
-        self._wait_ticks(before)
+        self.wait_ticks(before)
 
     def execute(self, line: str) -> bool:
         """Run one command line; False on ``quit``.
@@ -196,9 +208,9 @@ class Console:
             dvalues[bit] = v
             self.board_command(T.SET_GAINS, j, params=[1 << bit], dvalues=dvalues)
         elif cmd == "status":
-            print(format_joint(self._state(), _joint(rest[0])), file=self.out)
+            print(format_joint(self.state_now(), _joint(rest[0])), file=self.out)
         elif cmd == "statusall":
-            s = self._state()
+            s = self.state_now()
             print(f"tick {int(s['tick'])}  overruns {int(s['overruns'])}  "
                   f"refs rejected {int(s['refs_rejected'])}  "
                   f"t {float(s['time_s']):.2f} s", file=self.out)
@@ -211,12 +223,19 @@ class Console:
         return True
 
 
+def add_daemon_options(p: argparse.ArgumentParser, limited: str) -> None:
+    """Add the options every `Console` user takes: ``--instance`` (the daemon's channel
+    namespace) and ``--robot`` (whose joint limits the commands named ``limited``
+    respect)."""
+    p.add_argument("--instance", default="default", help="daemon instance (default)")
+    p.add_argument("--robot", default="drc-hubo", choices=("drc-hubo", "hubo2plus"),
+                   help=f"robot whose joint limits {limited} respect (default drc-hubo)")
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of ``hubo-console``; returns the exit code."""
     p = argparse.ArgumentParser(prog="hubo-console", description=__doc__.split("\n\n")[0])
-    p.add_argument("--instance", default="default", help="daemon instance (default)")
-    p.add_argument("--robot", default="drc-hubo", choices=("drc-hubo", "hubo2plus"),
-                   help="robot whose joint limits goto and comp respect (default drc-hubo)")
+    add_daemon_options(p, "goto and comp")
     p.add_argument("-c", dest="commands", metavar="CMDS",
                    help="run these ';'-separated commands instead of reading stdin")
     args = p.parse_args(argv)
