@@ -20,7 +20,7 @@ sys.path.insert(0, str(Path(__file__).parent))
 from fake_daemon import running_daemon  # noqa: E402
 from test_daemon_e2e import Daemon  # noqa: E402
 
-from daemon.channels import open_channel  # noqa: E402
+from daemon.channels import cleanup_stale, open_channel  # noqa: E402
 from daemon.neck import (  # noqa: E402
     MOVE_KEYS,
     NeckConfig,
@@ -112,7 +112,6 @@ def test_single_keys_reads_without_enter_and_restores_the_terminal():
 def test_bad_flags_and_unknown_keys_exit_2_in_one_line_and_nothing_moves(capsys, argv,
                                                                          message):
     with running_daemon("neck-refused") as (instance, loop, boards):
-        neck = open_channel("ref-neck", instance)
         assert main(["--instance", instance, *argv]) == 2
         out, err = capsys.readouterr()
         assert out == "" and len(err.splitlines()) == 1
@@ -120,8 +119,10 @@ def test_bad_flags_and_unknown_keys_exit_2_in_one_line_and_nothing_moves(capsys,
         ticks = loop.stats.ticks
         while loop.stats.ticks < ticks + 20:
             time.sleep(0.01)
-        assert neck.read_latest() is None
-        assert open_channel("ref", instance).read_latest() is None
+        for name in ("ref-neck", "ref"):
+            channel = open_channel(name, instance)
+            assert channel.read_latest() is None, name
+            channel.close()
         assert not boards.pos.any()
 
 
@@ -129,7 +130,7 @@ def test_neck_goals_go_on_ref_neck_over_a_playing_reference(capsys):
     """A player's ``ref`` keeps the other joints; the neck steps from the player's neck
     entries and hubo-neck never writes ``ref``."""
     with running_daemon("neck-over-ref") as (instance, loop, boards):
-        ref = open_channel("ref", instance)
+        ref, state = open_channel("ref", instance), open_channel("state", instance)
         r = new_sample(REF_DTYPE)
         r["ref"][JOINT_INDEX["RSP"]], r["ref"][NKY] = -0.2, 0.2
         ref.write(r)
@@ -138,10 +139,12 @@ def test_neck_goals_go_on_ref_neck_over_a_playing_reference(capsys):
         assert capsys.readouterr().out.splitlines() == ["q  NKY goal +0.700 rad",
                                                         "s  NK1 goal +0.300 rad"]
         assert int(ref.read_latest()["seq"]) == seq
-        s = open_channel("state", instance).read_latest()
+        ref.close()
+        s = state.read_latest()
         deadline = time.monotonic() + 10.0
         while abs(s["pos"][NKY] - 0.7) > 2e-3 and time.monotonic() < deadline:
-            s = open_channel("state", instance).wait_newer(int(s["time_ns"]), 1.0) or s
+            s = state.wait_newer(int(s["time_ns"]), 1.0) or s
+        state.close()
         assert s["pos"][[NKY, NK1, NK2]] == pytest.approx([0.7, 0.3, 0.0], abs=2e-3)
         assert s["pos"][JOINT_INDEX["RSP"]] == pytest.approx(-0.2, abs=2e-3)
 
@@ -183,6 +186,7 @@ def test_sim_daemon_neck_follows_the_keys_and_stops_at_its_limit(tmp_path, capsy
         d.stop()
     finally:
         d.close()
+        cleanup_stale(d.instance)
     rec = d.records()
     assert rec["ref_cmd"][:, NKY].max() <= hi and rec["ref"][:, NKY].max() <= hi
     assert rec["pos"][:, NKY].max() <= hi + 1e-3
