@@ -4,10 +4,10 @@ Both are `concurrent.futures` executors (Dask through ``Client.get_executor()``)
 runner (`execute.batch.runner`) has one code path and ships the same module-level job
 functions to either.
 
-- ``local``: `concurrent.futures.ProcessPoolExecutor` with ``workers`` processes, started
-  by a fork server (the parent has a progress-bar thread; forking it is unsafe), a fresh
-  process for every job (`local_engine`). One worker dying breaks the whole pool
-  (`BrokenProcessPool`); the runner then calls `Engine.restart`.
+- ``local``: a fresh worker process for every job, started by a fork server (the parent
+  has a progress-bar thread; forking it is unsafe), at most ``workers`` at a time
+  (`local_engine`, `FreshProcessExecutor`). A worker dying fails its job with
+  `BrokenProcessPool`, which the runner records as that job's error.
 - ``dask``: ``distributed.Client(address)`` against a running scheduler, or a
   ``LocalCluster`` of ``workers`` single-threaded worker processes when no address is
   given (``processes=False`` runs the workers as threads, for tests). Dask retries a
@@ -19,10 +19,11 @@ from __future__ import annotations
 
 import logging
 import multiprocessing
+import threading
 from concurrent.futures import Executor, Future, ProcessPoolExecutor
 from typing import Any
 
-__all__ = ["Engine", "dask_engine", "local_engine", "open_engine"]
+__all__ = ["Engine", "FreshProcessExecutor", "dask_engine", "local_engine", "open_engine"]
 
 log = logging.getLogger(__name__)
 
@@ -34,34 +35,24 @@ class Engine:
         name: ``local`` or ``dask``.
         slots: jobs the runner keeps in flight (one per worker core).
         description: one line for the user (workers, address, dashboard).
-        breaks_on_crash: a dead worker breaks the executor (process pools); the runner
-            then isolates the jobs that were in flight and calls `restart`.
     """
 
     def __init__(self, name: str, executor: Executor, slots: int, description: str,
-                 breaks_on_crash: bool, restart=None, close=None):
+                 close=None):
         self.name = name
         self.executor = executor
         self.slots = max(1, int(slots))
         self.description = description
-        self.breaks_on_crash = breaks_on_crash
-        self._restart = restart
         self._close = close
 
     def submit(self, fn, *args: Any) -> Future:
         """Run ``fn(*args)`` on a worker."""
         return self.executor.submit(fn, *args)
 
-    def restart(self) -> None:
-        """Replace a broken executor by a fresh one."""
-        if self._restart is None:
-            raise RuntimeError(f"engine {self.name} cannot restart")
-        self.executor = self._restart(self.executor)
-
     def close(self, cancel: bool = False) -> None:
         """Shut down (cancel jobs not started when ``cancel``)."""
         try:
-            if isinstance(self.executor, ProcessPoolExecutor):
+            if isinstance(self.executor, FreshProcessExecutor):
                 self.executor.shutdown(wait=not cancel, cancel_futures=cancel)
             else:  # Dask's ClientExecutor cancels its pending futures itself
                 self.executor.shutdown(wait=not cancel)
@@ -83,8 +74,50 @@ class Engine:
 FORKSERVER_PRELOAD = ("planner.search", "planner.output", "execute.validate.simulate")
 
 
+class FreshProcessExecutor(Executor):
+    """Runs each submitted call in a new process of its own: a one-worker
+    `ProcessPoolExecutor` per call, shut down when the call ends.
+
+    This is what ``ProcessPoolExecutor(max_tasks_per_child=1)`` promises, without its
+    replacement of exited workers, which on Python 3.11–3.13 can leave queued calls with
+    no worker, for ever (CPython gh-115634; a `batch-eval` test hung on it). The caller
+    bounds how many calls run at once (`execute.batch.runner` keeps ``slots`` in flight).
+
+    Args:
+        mp_context: the multiprocessing context the workers start from.
+    """
+
+    def __init__(self, mp_context):
+        self._ctx = mp_context
+        self._pools: set[ProcessPoolExecutor] = set()
+        self._lock = threading.Lock()
+        self._shut = False
+
+    def submit(self, fn, /, *args, **kwargs) -> Future:
+        with self._lock:
+            if self._shut:
+                raise RuntimeError("cannot submit after shutdown")
+            pool = ProcessPoolExecutor(max_workers=1, mp_context=self._ctx)
+            self._pools.add(pool)
+        fut = pool.submit(fn, *args, **kwargs)
+        fut.add_done_callback(lambda _f: self._retire(pool))
+        return fut
+
+    def _retire(self, pool: ProcessPoolExecutor) -> None:
+        with self._lock:
+            self._pools.discard(pool)
+        pool.shutdown(wait=False)
+
+    def shutdown(self, wait: bool = True, *, cancel_futures: bool = False) -> None:
+        with self._lock:
+            self._shut = True
+            pools = list(self._pools)
+        for pool in pools:
+            pool.shutdown(wait=wait, cancel_futures=cancel_futures)
+
+
 def local_engine(workers: int) -> Engine:
-    """A local process pool of ``workers`` processes, a fresh one for every job.
+    """Local processes, at most ``workers`` at a time, a fresh one for every job.
 
     A fresh process per job keeps a batch cell identical to ``plan-ladder`` with its
     seed: OMPL's random numbers can be seeded only once per process
@@ -94,15 +127,8 @@ def local_engine(workers: int) -> Engine:
     ctx = multiprocessing.get_context("forkserver")
     ctx.set_forkserver_preload(list(FORKSERVER_PRELOAD))  # no effect once it has started
 
-    def make() -> ProcessPoolExecutor:
-        return ProcessPoolExecutor(max_workers=workers, mp_context=ctx, max_tasks_per_child=1)
-
-    def restart(old: Executor) -> Executor:
-        old.shutdown(wait=False, cancel_futures=True)
-        return make()
-
-    return Engine("local", make(), workers, f"local process pool, {workers} worker"
-                  f"{'s' * (workers != 1)}", True, restart)
+    return Engine("local", FreshProcessExecutor(ctx), workers, f"local processes, "
+                  f"{workers} at a time, a fresh one per job")
 
 
 def dask_engine(address: str | None = None, workers: int = 1, processes: bool = True
@@ -144,7 +170,7 @@ def dask_engine(address: str | None = None, workers: int = 1, processes: bool = 
             cluster.close()
 
     # pure=False: every submission is its own task (no key deduplication or caching).
-    return Engine("dask", client.get_executor(pure=False), slots, where, False, None, close)
+    return Engine("dask", client.get_executor(pure=False), slots, where, close)
 
 
 def open_engine(name: str, workers: int, address: str | None = None) -> Engine:

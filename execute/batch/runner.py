@@ -7,10 +7,10 @@ At most ``engine.slots`` jobs are in flight. A validate job whose plan found no 
 recorded at once as a failure with cause ``no_plan`` (not simulated); one whose plan job
 errored is recorded as an error (and retried with it on resume).
 
-A worker that dies (segfault, ``os._exit``, out of memory) breaks a process pool: every
-job in flight gets `BrokenProcessPool`. Those jobs are *suspects*: the pool is
-restarted and they are re-run one at a time, alone, so a second break names the job
-that caused it, which is recorded as an error; the others run normally.
+A local worker that dies (segfault, ``os._exit``, out of memory) fails only its own job
+with `BrokenProcessPool` (each job has a process of its own,
+`execute.batch.engine.FreshProcessExecutor`), which is recorded as an error; the others
+run normally.
 """
 
 from __future__ import annotations
@@ -167,8 +167,7 @@ def _pending_jobs(plans: Sequence[PlanJob], validations: Sequence[ValidateJob],
 class _Scheduler:
     """Keeps at most ``engine.slots`` jobs in flight and records each as it ends.
 
-    A plan job's end releases its validate jobs to the front of the queue. After a broken
-    pool, the jobs that were in flight are suspects, re-run one at a time (``isolated``).
+    A plan job's end releases its validate jobs to the front of the queue.
     """
 
     def __init__(self, pending: _Pending, results: ResultsLog, engine: Engine,
@@ -180,9 +179,7 @@ class _Scheduler:
         self.out_s, self.on_record = out_s, on_record
         self.ran = 0
         self.in_flight: dict[Future, object] = {}
-        self.suspects: deque = deque()
-        self.isolated = False
-        self.submitted: set[str] = set()  # keys of jobs submitted (suspects' re-runs once)
+        self.submitted: set[str] = set()  # keys of jobs submitted
 
     def record(self, job, status: str, fields: dict) -> None:
         """Append a job's record to the results file."""
@@ -208,14 +205,10 @@ class _Scheduler:
                                                   f"{prec.get('error', '?')}"})
 
     def submit(self, job) -> None:
-        """Send a job to the engine (restarting a pool that broke since the last wait)."""
+        """Send a job to the engine."""
         args = (self.functions.plan, job, self.out_s) if isinstance(job, PlanJob) else \
             (self.functions.validate, job, self.plan_done[job.plan.key], self.out_s)
-        try:
-            fut = self.engine.submit(timed_call, *args)
-        except BrokenProcessPool:  # the pool broke after the last wait: start a new one
-            self.engine.restart()
-            fut = self.engine.submit(timed_call, *args)
+        fut = self.engine.submit(timed_call, *args)
         self.in_flight[fut] = job
         self.submitted.add(job.key)
 
@@ -227,32 +220,21 @@ class _Scheduler:
             self.release(job.key)
 
     def fill(self, max_jobs: int | None) -> None:
-        """Submit what may run now: one suspect alone, or ready jobs up to the slots."""
-        if self.isolated and not self.in_flight:
-            self.isolated = False
-        if self.suspects or self.isolated:
-            if not self.in_flight:
-                self.submit(self.suspects.popleft())
-                self.isolated = True
-        else:
-            while len(self.in_flight) < self.engine.slots and self.ready and \
-                    (max_jobs is None or len(self.submitted) < max_jobs):
-                self.submit(self.ready.popleft())
+        """Submit ready jobs up to the slots."""
+        while len(self.in_flight) < self.engine.slots and self.ready and \
+                (max_jobs is None or len(self.submitted) < max_jobs):
+            self.submit(self.ready.popleft())
 
-    def collect(self, done: set[Future]) -> bool:
-        """Record the jobs of finished futures; True if the pool broke under one."""
-        broken = False
+    def collect(self, done: set[Future]) -> None:
+        """Record the jobs of finished futures."""
         for fut in done:
             job = self.in_flight.pop(fut)
             try:
                 outcome = fut.result()
             except BrokenProcessPool:
-                broken = True
-                if self.isolated:
-                    self.finish(job, "error", {"error": "BrokenProcessPool: the worker "
-                                               "process died while running this job alone"})
-                else:
-                    self.suspects.append(job)
+                log.warning("%s: its worker process died", job.key)
+                self.finish(job, "error", {"error": "BrokenProcessPool: the worker process "
+                                           "died while running this job"})
                 continue
             except Exception as exc:  # a job error: record it, go on
                 msg, tb = _error_text(exc)
@@ -260,7 +242,6 @@ class _Scheduler:
                 self.finish(job, "error", {"error": msg, "traceback": tb})
                 continue
             self.finish(job, "ok", outcome)
-        return broken
 
     def run(self, max_jobs: int | None) -> None:
         """Submit and collect until nothing is left in flight; on any exception (Ctrl-C
@@ -271,12 +252,7 @@ class _Scheduler:
                 if not self.in_flight:
                     break
                 done, _ = wait(list(self.in_flight), return_when=FIRST_COMPLETED)
-                if self.collect(done):
-                    for fut in list(self.in_flight):  # the rest of the pool is gone too
-                        self.suspects.append(self.in_flight.pop(fut))
-                    log.warning("a worker died; re-running %d job(s) in flight one at a "
-                                "time", len(self.suspects))
-                    self.engine.restart()
+                self.collect(done)
         except BaseException:
             for fut in self.in_flight:
                 fut.cancel()
