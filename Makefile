@@ -11,7 +11,7 @@ install: $(STAMP)
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e ".[test,dask,view,ros]"
+	$(BIN)/python -m pip install --quiet -e ".[test,dask,view,ros,remote,station]"
 	touch $(STAMP)
 
 # The main job on the bundled DRC ladder: plan the climb, verify it kinematically, then
