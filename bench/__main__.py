@@ -1,6 +1,7 @@
 """``make bench``: run every benchmark and print its figures against the targets.
 
-Usage: ``python -m bench [--only planner,sim,tracking,daemon,channels,can,batch] [--json FILE]``.
+Usage: ``python -m bench [--only planner,sim,tracking,daemon,channels,can,batch,bridge]
+[--json FILE]``.
 Figures are measurements on this machine; a target missed is shown, not hidden.
 """
 
@@ -12,7 +13,7 @@ import json
 import sys
 import time
 
-SUITES = ("planner", "sim", "tracking", "daemon", "channels", "can", "batch")
+SUITES = ("planner", "sim", "tracking", "daemon", "channels", "can", "batch", "bridge")
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -199,7 +199,9 @@ class RobotBridge:
             self.stats.states_published += 1
             self.stats.state_bytes += len(payload)
             last_ns = int(s["time_ns"])
-            next_ns = last_ns + period_ns
+            # on a grid of periods (a daemon writing at the same rate, with jitter, is not
+            # halved), never two samples within half a period
+            next_ns = max(next_ns + period_ns, last_ns + period_ns // 2)
         return self.stats
 
     # ------------------------------------------------------------------ references in
