@@ -397,11 +397,10 @@ class BoardModel:
         status = np.where(s.active, 0, int(StatusFlag.TRIPPED)) | \
             np.where(s.pwm, int(StatusFlag.COMPLIANT), 0)
         sample["status"] = status
-        for k in range(4):
-            sample["ft"][k]["mx"], sample["ft"][k]["my"], sample["ft"][k]["fz"] = \
-                s.sensors.ft[k]
-        for k in range(3):
-            for i, f in enumerate(("ax", "ay", "az", "wx", "wy", "wz")):
-                sample["imu"][k][f] = s.sensors.imu[k, i]
+        ft, imu = sample["ft"], sample["imu"]
+        for i, f in enumerate(("mx", "my", "fz")):
+            ft[f] = s.sensors.ft[:, i]
+        for i, f in enumerate(("ax", "ay", "az", "wx", "wy", "wz")):
+            imu[f] = s.sensors.imu[:, i]
         sample["power"]["V"], sample["power"]["I"], sample["power"]["P"] = \
             s.power_v, s.power_a, s.power_w

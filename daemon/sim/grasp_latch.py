@@ -203,6 +203,13 @@ class GraspLatch:
         self._finger_joints = np.array([joint_of_qpos[int(a)] for a in self.finger_qpos])
         self._finger_range = model.jnt_range[self._finger_joints].copy()
         self._jac = np.zeros((6, model.nv))  # palm site: translation rows, rotation rows
+        # The robot's floating base: its six velocities see every wrench on the hand
+        # through an invertible 6×6 block of the palm's Jacobian.
+        root = int(model.body_rootid[self.body_id])
+        free = int(model.body_jntadr[root])
+        if free < 0 or model.jnt_type[free] != mujoco.mjtJoint.mjJNT_FREE:
+            raise ValueError(f"{hand} hand: its robot has no floating base")
+        self._base_dofs = slice(int(model.jnt_dofadr[free]), int(model.jnt_dofadr[free]) + 6)
         self._qfrc = np.zeros(model.nv)
         self.reset()
 
@@ -261,7 +268,10 @@ class GraspLatch:
         mujoco.mj_mulJacTVec(m, d, self._qfrc, f)
         J = self._jac
         mujoco.mj_jac(m, d, J[:3], J[3:], d.site_xpos[self.palm_site], self.body_id)
-        w = np.linalg.lstsq(J.T, self._qfrc, rcond=None)[0]
+        # qfrc = Jᵀ w; the floating base's rows of it determine w (the ladder side of
+        # the weld is fixed, so no other body takes this force)
+        b = self._base_dofs
+        w = np.linalg.solve(J[:, b].T, self._qfrc[b])
         return w[:3], w[3:]
 
     # ------------------------------------------------------------------ update

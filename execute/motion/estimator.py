@@ -17,6 +17,7 @@ It reads `execute.motion.sensed_state.SensedState` only.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -56,16 +57,31 @@ class BodyEstimate:
 
 def tilt_from_gravity(up_in_pelvis: np.ndarray) -> np.ndarray:
     """The yaw-free rotation R_world_pelvis whose world z axis is ``up_in_pelvis`` seen
-    from the pelvis (the smallest rotation from the pelvis z axis to it)."""
-    u = up_in_pelvis / np.linalg.norm(up_in_pelvis)
-    z = np.array([0.0, 0.0, 1.0])
-    axis = np.cross(u, z)
-    s, c = np.linalg.norm(axis), float(u @ z)
+    from the pelvis (the smallest rotation from the pelvis z axis to it).
+
+    Rodrigues' formula about k = (u × z)/|u × z| by the angle between u and z, written
+    out for k's zero z component (K² = k kᵀ − I): it runs every tick.
+    """
+    x, y, z = (float(v) for v in up_in_pelvis)
+    n = math.sqrt(x * x + y * y + z * z)
+    ux, uy, c = x / n, y / n, z / n
+    s = math.sqrt(ux * ux + uy * uy)  # sin of the angle; c = u·z its cos
     if s < 1e-12:
         return np.eye(3)
-    k = axis / s
-    K = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
-    return np.eye(3) + s * K + (1 - c) * K @ K
+    kx, ky = uy / s, -ux / s
+    v = 1.0 - c
+    return np.array([[1.0 + v * (kx * kx - 1.0), v * kx * ky, s * ky],
+                     [v * kx * ky, 1.0 + v * (ky * ky - 1.0), -s * kx],
+                     [-s * ky, s * kx, c]])
+
+
+def _rigid_inverse(T: np.ndarray) -> np.ndarray:
+    """The inverse of a rigid transform (4, 4): (Rᵀ, −Rᵀ p)."""
+    out = np.eye(4)
+    Rt = T[:3, :3].T
+    out[:3, :3] = Rt
+    out[:3, 3] = -Rt @ T[:3, 3]
+    return out
 
 
 class StateEstimator:
@@ -126,7 +142,7 @@ class StateEstimator:
         for side in SIDES:
             if side in self._anchors and load[side] < cfg.foot_contact_off_n:
                 del self._anchors[side]
-        candidates = [(load[side], self._anchors[side] @ np.linalg.inv(feet[side]))
+        candidates = [(load[side], self._anchors[side] @ _rigid_inverse(feet[side]))
                       for side in SIDES if side in self._anchors]
         if candidates:
             total = sum(max(w, 1e-6) for w, _ in candidates)
@@ -141,4 +157,5 @@ class StateEstimator:
             s.time_s, T_wp.copy(), R_tilt, {side: side in self._anchors for side in SIDES},
             {side: (T_wp @ frames[side][1])[:3, 3] for side in SIDES},
             {side: (T_wp @ feet[side])[:3, 3] for side in SIDES},
-            {side: float(np.mean(q[self._fingers[side]])) for side in SIDES})
+            {side: float(q[self._fingers[side]].sum()) / len(self._fingers[side])
+             for side in SIDES})

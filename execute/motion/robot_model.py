@@ -51,6 +51,9 @@ class MotionRobotModel:
                 j = m.joints[m.getJointId(name)]
                 self._q_of_col[c], self._v_of_col[c] = j.idx_q, j.idx_v
         self._have = self._q_of_col >= 0
+        self._q_cols = self._q_of_col[self._have]
+        self._v_cols = self._v_of_col[self._have]
+        self._neutral = pin.neutral(m)
         self.lower_rad = np.full(len(JOINT_NAMES), -np.inf)
         self.upper_rad = np.full(len(JOINT_NAMES), np.inf)
         self.lower_rad[self._have] = m.lowerPositionLimit[self._q_of_col[self._have]]
@@ -69,8 +72,8 @@ class MotionRobotModel:
     def configuration(self, q_cols_rad: np.ndarray, T_world_pelvis: np.ndarray | None = None
                       ) -> np.ndarray:
         """pinocchio's q for the 40 columns and a pelvis pose (identity when None)."""
-        q = pin.neutral(self.model)
-        q[self._q_of_col[self._have]] = np.asarray(q_cols_rad)[self._have]
+        q = self._neutral.copy()
+        q[self._q_cols] = np.asarray(q_cols_rad)[self._have]
         if T_world_pelvis is not None:
             q[:3] = T_world_pelvis[:3, 3]
             q[3:7] = pin.Quaternion(T_world_pelvis[:3, :3]).coeffs()
@@ -87,7 +90,7 @@ class MotionRobotModel:
         T[:3, :3] = R_world_pelvis
         g = pin.computeGeneralizedGravity(self.model, self.data, self.configuration(q_cols_rad, T))
         out = np.zeros(len(JOINT_NAMES))
-        out[self._have] = g[self._v_of_col[self._have]]
+        out[self._have] = g[self._v_cols]
         return out
 
     def com_m(self, q_cols_rad: np.ndarray, T_world_pelvis: np.ndarray) -> np.ndarray:

@@ -11,6 +11,8 @@ holds and unwound while it moves in the air.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from robot.joints import JOINT_INDEX
@@ -51,9 +53,9 @@ class WristRelief:
                            * self.motors.kt_nm_per_a[j])
             if abs(torque) > self.relief_fraction * self.limit_nm[j]:
                 # the loop pushes with +τ towards a reference above the joint: give way
-                off -= np.sign(torque) * self.speed * dt_s
-        else:
-            off -= np.sign(off) * min(abs(off), self.speed * dt_s)
-        off = float(np.clip(off, -self.max_offset_rad, self.max_offset_rad))
+                off -= math.copysign(self.speed * dt_s, torque)
+        elif off != 0.0:
+            off -= math.copysign(min(abs(off), self.speed * dt_s), off)
+        off = min(max(off, -self.max_offset_rad), self.max_offset_rad)
         self.offset_rad[j] = off
         return off

@@ -156,7 +156,7 @@ class VerdictMonitor:
                             "overload_s": ev.overload_s})
         d = self.data
         z = float(d.xpos[self.pelvis][2])
-        tilt = math.acos(float(np.clip(d.xmat[self.pelvis][8], -1.0, 1.0)))
+        tilt = math.acos(min(max(float(d.xmat[self.pelvis][8]), -1.0), 1.0))
         if z < self.config.min_pelvis_height_m or tilt > self.config.max_tilt_rad:
             return Failure(FailureCause.FALL, time_s, line,
                            f"pelvis at {z:.2f} m (limit {self.config.min_pelvis_height_m} m), "
