@@ -54,9 +54,10 @@ MAX_CLAMP_TOLERANCE_RAD = 0.1
 #: resolve (about 1e-5 rad); the rounding error (at most 5e-7 rad) stays within
 #: ``LIMIT_TOLERANCE_RAD`` of a value on a limit.
 DECIMALS = 6
-#: gzip's level for ``.traj.gz``: 6 (gzip's default) 5.84x on a DRC climb in 1.5 s per
-#: 30,000 lines, level 9 hardly smaller at twice the time.
-GZIP_LEVEL = 6
+#: gzip's level for ``.traj.gz``. On a whole DRC climb (300,000 lines, 92 MB of text):
+#: level 6 (gzip's default) 24.7 MB in 5.8 s, level 5 24.9 MB in 3.1 s, level 4 26.3 MB
+#: in 1.8 s (CPU seconds on the development VM, 2026-11-27).
+GZIP_LEVEL = 5
 
 
 def is_gzip_path(path: str | os.PathLike) -> bool:
