@@ -11,8 +11,8 @@ and taking the lock ourselves to test it would refuse a player starting at that 
 A pause is sent only to a player that handles SIGUSR1 (``/proc/<pid>/status``,
 ``SigCgt``): without ``-p`` the signal's default action would kill the player.
 
-The file name is `execute.play.lock`'s convention, restated here because the daemon may
-not import ``execute`` (docs/architecture.md, rule 1).
+The lock file's name is defined here (`player_lock_file`), on the robot side, and
+`execute.play.lock` takes it from here.
 """
 
 from __future__ import annotations
@@ -29,8 +29,8 @@ __all__ = ["PlayerCommand", "player_lock_file", "playing_pid", "signal_player"]
 
 log = logging.getLogger(__name__)
 
-LOCK_DIR = Path("/dev/shm")
-LOCK_PREFIX = "hubo-ladder-player."  # execute.play.lock.LOCK_PREFIX
+LOCK_DIR = Path("/dev/shm")  #: next to the daemon's channel files
+LOCK_PREFIX = "hubo-ladder-player."
 PROC_LOCKS = Path("/proc/locks")
 
 

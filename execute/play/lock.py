@@ -28,14 +28,13 @@ import os
 import re
 from pathlib import Path
 
+from daemon.player_control import player_lock_file
 from robot.errors import HuboLadderError, InputError
 
 __all__ = ["PlayerBusyError", "PlayerLock", "player_lock_path"]
 
 log = logging.getLogger(__name__)
 
-LOCK_DIR = Path("/dev/shm")  #: next to the daemon's channel files
-LOCK_PREFIX = "hubo-ladder-player."
 _INSTANCE_RE = re.compile(r"^[A-Za-z0-9_-]{1,40}$")  # as the channels' instance names
 
 
@@ -58,7 +57,7 @@ def player_lock_path(instance: str) -> Path:
     """
     if not _INSTANCE_RE.match(instance):
         raise InputError(f"--instance {instance!r}: use 1–40 characters of A–Z a–z 0–9 _ -")
-    return LOCK_DIR / f"{LOCK_PREFIX}{instance}.lock"
+    return player_lock_file(instance)
 
 
 def _pid_running(pid: int) -> bool:
