@@ -1,0 +1,97 @@
+"""``hubo-init``: the operator's web page (the thesis's hubo-init GUI).
+
+    hubo-init [--instance NAME] [--robot R] [--host 127.0.0.1] [--port 8080]
+              [--rate-hz 10] [--camera none|sim] [--ladder drc] [--camera-fps 4]
+
+Serves one page (nicegui) that shows every joint's position, reference, error, mode and
+board state (faults red, warnings amber), the F/T sensors, IMUs and battery, refreshed
+from the daemon's ``state`` channel ``--rate-hz`` times a second; buttons to home all,
+home or reset one joint, initialise the sensors, pause and stop the player; a line for
+any hubo-console command (goto, comp, kp, kd, maxPWM); hubo-neck's keys. Every refusal is
+shown with its reason. ``--camera sim`` renders the head camera of a sim daemon (started
+with the same ``--ladder`` and ``--robot``) ``--camera-fps`` times a second.
+
+Open http://HOST:PORT/ in a browser. Ctrl-C or SIGTERM stops the server.
+
+Exit codes: 0 stopped, 1 failed while running, 2 bad input (an option out of its range,
+named with the range): nothing is served.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import sys
+
+from daemon.console import add_daemon_options
+from robot.errors import InputError, parse_finite, run_cli
+
+__all__ = ["CAMERA_FPS_RANGE_HZ", "RATE_RANGE_HZ", "main"]
+
+#: Allowed page refresh rates [Hz]: slower hides a fault for over a second; faster sends
+#: the 40 rows to every browser more often than an operator can read them.
+RATE_RANGE_HZ = (1.0, 20.0)
+#: Allowed head camera rates [Hz]: each frame is a MuJoCo render on a shared CPU.
+CAMERA_FPS_RANGE_HZ = (1.0, 10.0)
+PORT_RANGE = (1, 65535)
+
+
+def _in_range(flag: str, text: str, allowed: tuple[float, float], unit: str) -> float:
+    """``text`` as a number within ``allowed`` (both ends included)."""
+    value = parse_finite(text, flag)
+    if not allowed[0] <= value <= allowed[1]:
+        raise InputError(f"{flag} {text} refused: allowed [{allowed[0]:g}, {allowed[1]:g}]"
+                         f"{unit}; nothing served")
+    return value
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="hubo-init", description=__doc__.split("\n\n")[0])
+    add_daemon_options(p, "goto, comp and the neck keys")
+    p.add_argument("--host", default="127.0.0.1",
+                   help="address to serve on (default 127.0.0.1: this machine only)")
+    p.add_argument("--port", default="8080", help="TCP port (default 8080)")
+    p.add_argument("--rate-hz", default="10", metavar="HZ",
+                   help="state refresh of the page (default 10, allowed [1, 20]) [Hz]")
+    p.add_argument("--camera", choices=("none", "sim"), default="none",
+                   help="head camera: sim renders a sim daemon's with MuJoCo (default none)")
+    p.add_argument("--ladder", default="drc",
+                   help="--camera sim: the sim daemon's ladder (name or spec file; drc)")
+    p.add_argument("--camera-fps", default="4", metavar="HZ",
+                   help="--camera sim: frames a second (default 4, allowed [1, 10]) [Hz]")
+    return p
+
+
+def _run(args: argparse.Namespace) -> int:
+    rate_hz = _in_range("--rate-hz", args.rate_hz, RATE_RANGE_HZ, " Hz")
+    fps = _in_range("--camera-fps", args.camera_fps, CAMERA_FPS_RANGE_HZ, " Hz")
+    port = _in_range("--port", args.port, PORT_RANGE, "")
+    if port != int(port):
+        raise InputError(f"--port {args.port} refused: a whole number in [1, 65535]")
+    from nicegui import app, ui
+
+    from daemon.station.commands import StationCommands
+    from daemon.station.head_camera import SimHeadCamera
+    from daemon.station.page import Station, build_page
+
+    camera = SimHeadCamera(args.instance, args.ladder, args.robot, fps).start() \
+        if args.camera == "sim" else None
+    station = Station(args.instance, StationCommands(args.instance, args.robot), rate_hz,
+                      camera)
+    app.on_shutdown(station.close)
+    print(f"hubo-init: http://{args.host}:{int(port)}/ for instance {args.instance!r}, "
+          f"{rate_hz:g} Hz, camera {args.camera}", file=sys.stderr, flush=True)
+    ui.run(lambda: build_page(station), host=args.host, port=int(port), title="hubo-init",
+           reload=False, show=False, show_welcome_message=False, favicon="🪜")
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of ``hubo-init``; returns the exit code."""
+    args = _parser().parse_args(argv)
+    logging.basicConfig(level=logging.WARNING, format="%(name)s: %(message)s")
+    return run_cli("hubo-init", lambda: _run(args))
+
+
+if __name__ == "__main__":
+    sys.exit(main())
