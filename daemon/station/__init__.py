@@ -2,8 +2,8 @@
 player's pause and stop, and the simulated head camera.
 
 - `state_view`: a state sample as rows (joints graded by `Severity`, sensors);
-- `commands`: the page's commands, hubo-console's and hubo-neck's, as `Outcome`\\ s;
-- `player_control`: pause and stop ``play-trajectory`` by signal;
+- `commands`: the page's commands (hubo-console's, hubo-neck's, the player's pause and
+  stop of `daemon.player_control`) as `Outcome`\\ s;
 - `head_camera`: the sim's head camera rendered by MuJoCo (imported only with
   ``--camera sim``);
 - `page`: the nicegui layout; `cli`: ``hubo-init``.

@@ -5,8 +5,9 @@ The commands are hubo-console's (`daemon.console.Console.execute`: home, homeAll
 iniSensors, goto, comp, kp, kd, maxPWM, with its refusals of positions beyond a joint's
 limits and gains beyond the safety limits) and hubo-neck's keys
 (`daemon.neck.press`, bounded by the neck's limits); the player's pause and stop go
-through `daemon.station.player_control`. Nothing is checked twice here, so the page
-refuses exactly what the terminal tools refuse, with the same words.
+through `daemon.player_control` (the signals hubo-bridge sends too). Nothing is checked
+twice here, so the page refuses exactly what the terminal tools refuse, with the same
+words.
 
 Each command blocks until the daemon has ticked past it (at most about a second); the page
 runs them in a worker thread, one at a time (a lock), as a terminal would.
@@ -20,7 +21,7 @@ from typing import NamedTuple
 
 from daemon.console import Console
 from daemon.neck import NeckConfig, NeckLink, default_config, press
-from daemon.station.player_control import pause_player, stop_player
+from daemon.player_control import PlayerCommand, signal_player
 from robot.errors import HuboLadderError, InputError
 
 __all__ = ["Outcome", "StationCommands"]
@@ -117,9 +118,12 @@ class StationCommands:
         return self._run(f"neck {key}", job)
 
     def pause_player(self) -> Outcome:
-        """Toggle the running player's pause."""
-        return self._run("pause", lambda: pause_player(self.instance))
+        """Toggle the running player's pause (SIGUSR1; refused unless it runs with -p)."""
+        return self._run("pause", lambda: "pause toggled: SIGUSR1 to play-trajectory pid "
+                         f"{signal_player(self.instance, PlayerCommand.PAUSE)}")
 
     def stop_player(self) -> Outcome:
-        """Stop the running player; the robot holds its last reference."""
-        return self._run("stop", lambda: stop_player(self.instance))
+        """Stop the running player (SIGTERM); the robot holds its last reference."""
+        return self._run("stop", lambda: "stopped: SIGTERM to play-trajectory pid "
+                         f"{signal_player(self.instance, PlayerCommand.STOP)}; the robot "
+                         "holds the last reference")

@@ -87,7 +87,7 @@ class Station:
 
 
 def _fmt(rad: float) -> str:
-    return f"{rad:+.4f}"
+    return f"{round(rad, 4) + 0.0:+.4f}"  # + 0.0: no "-0.0000" for a joint at rest
 
 
 def _table_rows(state: np.ndarray, ref_mode: np.ndarray | None) -> list[dict]:
