@@ -113,7 +113,12 @@ def test_commands_run_hubo_console_and_show_its_refusals():
         finally:
             ref.close()
             commands.close()
-    out = StationCommands(instance).home("RSP")  # the daemon is gone
+    gone = StationCommands(instance)
+    try:
+        out = gone.home("RSP")  # the daemon is gone
+    finally:
+        gone.close()
+        cleanup_stale(instance)
     assert not out.ok and "no hubo-daemon is ticking" in out.text
 
 
@@ -156,6 +161,7 @@ def test_pause_and_stop_signal_only_a_player_that_holds_the_lock():
         p.wait(10)
     finally:
         commands.close()
+        cleanup_stale(instance)
         player_lock_path(instance).unlink(missing_ok=True)
 
 
