@@ -28,7 +28,7 @@ from test_daemon_e2e import ENV, PY, ROOT, Daemon  # noqa: E402
 
 from daemon.channels import cleanup_stale, open_channel  # noqa: E402
 from daemon.control_modes import RefMode  # noqa: E402
-from daemon.station import StationCommands  # noqa: E402
+from daemon.station import LocalLink  # noqa: E402
 from daemon.station.cli import main  # noqa: E402
 from daemon.station.state_view import Severity, joint_rows, sensor_rows  # noqa: E402
 from daemon.structs import STATE_DTYPE, StatusFlag, new_sample  # noqa: E402
@@ -94,7 +94,7 @@ def test_bad_options_exit_2_in_one_line(argv, says):
 def test_commands_run_hubo_console_and_show_its_refusals():
     hi = float(joint_limits("drc-hubo").upper_rad[RKN])
     with running_daemon("station-cmd") as (instance, loop, boards):
-        commands = StationCommands(instance)
+        commands = LocalLink(instance)
         ref = open_channel("ref", instance)
         try:
             out = commands.console_line("goto RKN 3.0")
@@ -113,7 +113,7 @@ def test_commands_run_hubo_console_and_show_its_refusals():
         finally:
             ref.close()
             commands.close()
-    gone = StationCommands(instance)
+    gone = LocalLink(instance)
     try:
         out = gone.home("RSP")  # the daemon is gone
     finally:
@@ -141,7 +141,7 @@ def test_pause_and_stop_signal_only_a_player_that_holds_the_lock():
     from execute.play.lock import player_lock_path
 
     instance = f"station-play-{os.getpid()}"
-    commands = StationCommands(instance)
+    commands = LocalLink(instance)
     try:
         out = commands.pause_player()
         assert not out.ok and "no play-trajectory is playing" in out.text
@@ -186,14 +186,23 @@ def _free_port() -> int:
 
 
 class Page:
-    """A sim daemon (not homed), hubo-init with the sim head camera, and Chromium on it."""
+    """A sim daemon (not homed), hubo-init on it, and Chromium on the page.
 
-    def __init__(self, tmp: Path):
-        self.daemon = Daemon(tmp, "station", "--backend", "sim").start()
+    Args:
+        tmp: a folder for the daemon's log and Chromium's profile.
+        daemon: a started sim daemon; a new one when None.
+        server_args: hubo-init's options besides ``--port`` (default: the daemon's
+            instance, with the sim head camera).
+    """
+
+    def __init__(self, tmp: Path, daemon: Daemon | None = None,
+                 server_args: list[str] | None = None):
+        self.daemon = daemon or Daemon(tmp, "station", "--backend", "sim").start()
         self.port = _free_port()
+        args = server_args or ["--instance", self.daemon.instance, "--camera", "sim"]
         self.server = subprocess.Popen(
-            [PY, "-m", "daemon.station.cli", "--instance", self.daemon.instance, "--port",
-             str(self.port), "--camera", "sim"], env={**ENV, "MUJOCO_GL": "egl"}, cwd=ROOT,
+            [PY, "-m", "daemon.station.cli", "--port", str(self.port), *args],
+            env={**ENV, "MUJOCO_GL": "egl"}, cwd=ROOT,
             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
         self.url = f"http://127.0.0.1:{self.port}/"
         deadline = time.monotonic() + 60
@@ -216,7 +225,9 @@ class Page:
             f"(() => {{ const r = {ROW_OF.format(name=name)}; return r ? {expression} "
             ": null; })()")
 
-    def close(self) -> None:
+    def close(self, *before_daemon) -> None:
+        """Stop Chromium and hubo-init, call each of ``before_daemon``, stop the daemon and
+        remove its channel files."""
         self.browser.close()
         self.server.send_signal(signal.SIGTERM)
         try:
@@ -224,8 +235,50 @@ class Page:
         except subprocess.TimeoutExpired:
             self.server.kill()
             self.server.communicate()
+        for job in before_daemon:
+            job()
         self.daemon.close()
         cleanup_stale(self.daemon.instance)
+
+
+def home_one_joint_from_the_page(page: Page, joint: str) -> None:
+    """On a page of a daemon with no joint homed: choose ``joint``, click "Home"; the
+    daemon's own state channel shows it homed (and no other), then the page does."""
+    b = page.browser
+    b.wait_for("document.body.innerText.includes('homed 0/40')")
+    b.click(".q-select")
+    b.wait_for("[...document.querySelectorAll('.q-item')].some(e => "
+               f"e.textContent.trim() === {joint!r})")
+    b.click(".q-item", joint)
+    b.wait_for(f"document.querySelector('.q-select').textContent.includes({joint!r})")
+    b.click("button", "Home")
+    j = JOINT_INDEX[joint]
+    s = page.daemon.wait_until(lambda s: s["zeroed"][j], 10.0)
+    assert int(np.sum(s["zeroed"])) == 1
+    b.wait_for(f"(() => {{ const r = {ROW_OF.format(name=joint)}; "
+               "return r.cells[5].textContent.trim() === 'OK'; })()")
+    assert "homed 1/40" in b.text()
+
+
+def refusal_shown_and_nothing_sent(page: Page, line: str, *shown: str) -> None:
+    """Type ``line`` into the page's hubo-console line and click "Run": the page shows
+    each of ``shown`` (in its log, and as a notification), and the daemon's ``ref``
+    channel got nothing."""
+    b = page.browser
+    ref = open_channel("ref", page.daemon.instance)
+    try:
+        before = ref.read_latest()
+        b.click("input[aria-label='command (hubo-console)']")
+        b.type_text(line)
+        b.click("button", "Run")
+        for text in shown:
+            b.wait_for(f"document.body.innerText.includes({text!r})")
+        assert b.evaluate("document.querySelector('.q-notification') !== null")
+        after = ref.read_latest()
+        assert after is None if before is None else int(after["seq"]) == int(before["seq"])
+    finally:
+        ref.close()
+        b.evaluate("document.activeElement.blur()")
 
 
 @pytest.fixture(scope="module")
@@ -260,38 +313,14 @@ def test_the_page_shows_every_joint_from_the_state_channel(page):
 
 @needs_chromium
 def test_home_homes_the_chosen_joint(page):
-    b = page.browser
-    b.wait_for("document.body.innerText.includes('homed 0/40')")
-    b.click(".q-select")
-    b.wait_for("[...document.querySelectorAll('.q-item')].some(e => "
-               "e.textContent.trim() === 'RKN')")
-    b.click(".q-item", "RKN")
-    b.wait_for("document.querySelector('.q-select').textContent.includes('RKN')")
-    b.click("button", "Home")
-    s = page.daemon.wait_until(lambda s: s["zeroed"][RKN], 10.0)
-    assert int(np.sum(s["zeroed"])) == 1
-    b.wait_for(f"(() => {{ const r = {ROW_OF.format(name='RKN')}; "
-               "return r.cells[5].textContent.trim() === 'OK'; })()")
-    assert "homed 1/40" in b.text()
+    home_one_joint_from_the_page(page, "RKN")
 
 
 @needs_chromium
 def test_a_refused_command_shows_its_reason_and_sends_nothing(page):
-    b = page.browser
-    ref = open_channel("ref", page.daemon.instance)
-    try:
-        before = ref.read_latest()
-        b.click("input[aria-label='command (hubo-console)']")
-        b.type_text("goto RKN 3.0")
-        b.click("button", "Run")
-        hi = float(joint_limits("drc-hubo").upper_rad[RKN])
-        b.wait_for(f"document.body.innerText.includes('RKN is allowed [0, {hi:.4g}] rad')")
-        assert "goto RKN 3.0 REFUSED" in b.text()
-        assert ref.read_latest() is None or before is not None and \
-            int(ref.read_latest()["seq"]) == int(before["seq"])
-    finally:
-        ref.close()
-        b.evaluate("document.activeElement.blur()")
+    hi = float(joint_limits("drc-hubo").upper_rad[RKN])
+    refusal_shown_and_nothing_sent(page, "goto RKN 3.0", "goto RKN 3.0 REFUSED: ",
+                                   f"RKN is allowed [0, {hi:.4g}] rad")
 
 
 @needs_chromium

@@ -27,13 +27,55 @@ import logging
 import signal
 import sys
 import threading
+from typing import TYPE_CHECKING
 
 from robot.errors import InputError, run_cli
 
-__all__ = ["main"]
+__all__ = ["add_operator_options", "main", "operator_endpoint_and_tls"]
+
+if TYPE_CHECKING:
+    from daemon.remote.session_config import TlsFiles
 
 PROG = "hubo-bridge"
 FIRST_STATE_TIMEOUT_S = 5.0  #: the operator waits this long for the robot's first state [s]
+
+
+def _add_tls_options(p: argparse.ArgumentParser, name_default: str | None, name_help: str,
+                     required: bool) -> None:
+    """``--tls-dir`` and ``--name``: a node's TLS files, as ``hubo-bridge certs`` wrote them."""
+    p.add_argument("--tls-dir", required=required,
+                   help="directory of ca.pem, NAME.pem, NAME.key")
+    p.add_argument("--name", default=name_default, required=required and name_default is None,
+                   help=name_help)
+
+
+def add_operator_options(p: argparse.ArgumentParser, connect_flag: str = "--connect",
+                         required: bool = True) -> None:
+    """The operator side's options: the robot bridge's endpoint (``connect_flag``) and this
+    operator's certificate (``--tls-dir``, ``--name``). ``hubo-bridge operator`` and
+    ``hubo-init --bridge`` take them; read them back with `operator_endpoint_and_tls`.
+
+    Args:
+        p: the parser.
+        connect_flag: the endpoint's option name.
+        required: whether argparse requires them (False: the caller checks).
+    """
+    p.add_argument(connect_flag, required=required, metavar="tls/HOST:PORT",
+                   help="the robot bridge's endpoint")
+    _add_tls_options(p, None, "this operator's certificate name", required)
+
+
+def operator_endpoint_and_tls(args: argparse.Namespace, connect_flag: str = "--connect"
+                              ) -> tuple[str, TlsFiles]:
+    """The endpoint and the `TlsFiles` of the options of `add_operator_options`.
+
+    Raises:
+        InputError: the endpoint is not ``tls/HOST:PORT``, or a TLS file is missing.
+    """
+    from daemon.remote.session_config import TlsFiles, check_endpoint
+
+    endpoint = check_endpoint(connect_flag, getattr(args, connect_flag.lstrip("-")))
+    return endpoint, TlsFiles.from_dir(args.tls_dir, args.name)
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -49,12 +91,11 @@ def _parser() -> argparse.ArgumentParser:
                         "localhost and 127.0.0.1)")
     for name in ("robot", "operator"):
         s = sub.add_parser(name, help=f"the {name} side")
-        s.add_argument("--tls-dir", required=True, help="directory of ca.pem, NAME.pem, NAME.key")
         s.add_argument("--instance", default="default", help="daemon instance (default)")
         s.add_argument("--duration-s", type=float, help="stop after this long [s]")
         s.add_argument("-v", "--verbose", action="store_true", help="log at INFO")
     r = sub.choices["robot"]
-    r.add_argument("--name", default="robot", help="this node's certificate name (robot)")
+    _add_tls_options(r, "robot", "this node's certificate name (robot)", True)
     r.add_argument("--listen", default="tls/0.0.0.0:7447", help="endpoint, tls/HOST:PORT")
     r.add_argument("--allow-writer", action="append", default=[], metavar="NAME",
                    help="certificate name of an operator that may write (repeat)")
@@ -66,8 +107,7 @@ def _parser() -> argparse.ArgumentParser:
                    help="link allowance [s]: commands sent on a state older than one period "
                         "plus this are dropped (default 0.1, allowed (0, 1])")
     o = sub.choices["operator"]
-    o.add_argument("--name", required=True, help="this operator's certificate name")
-    o.add_argument("--connect", required=True, help="the robot bridge, tls/HOST:PORT")
+    add_operator_options(o)
     what = o.add_mutually_exclusive_group(required=True)
     what.add_argument("-c", dest="commands", metavar="CMDS", help="';'-separated commands")
     what.add_argument("--mirror", metavar="LOCAL", help="mirror into local instance LOCAL")
@@ -123,10 +163,8 @@ def _robot(args: argparse.Namespace) -> int:
 
 def _operator(args: argparse.Namespace) -> int:
     from daemon.remote.operator import BridgeOperator, wait_first_state
-    from daemon.remote.session_config import TlsFiles, check_endpoint
 
-    check_endpoint("--connect", args.connect)
-    tls = TlsFiles.from_dir(args.tls_dir, args.name)
+    _, tls = operator_endpoint_and_tls(args)
     if args.mirror is not None:
         return _mirror(args, tls)
     commands = [c.strip() for c in args.commands.split(";") if c.strip()]

@@ -36,7 +36,16 @@ COMMAND_TIMEOUT_S = 2.0  #: wait at most this for the robot's answer [s]
 
 
 class RemoteRefusal(InputError):
-    """The robot refused a command (its local tool's check, or a stale command)."""
+    """The robot refused a command (its local tool's check, or a stale command).
+
+    Attributes:
+        reason: the robot's words without the topic: the local tool's refusal as that
+            tool words it (a page shows it as a local refusal), or ``stale: ...``.
+    """
+
+    def __init__(self, topic: Topic, text: str, answer: str):
+        self.reason = answer.removeprefix("refused: ")
+        super().__init__(f"{topic.value} {text!r}: {answer}")
 
 
 class BridgeOperator:
@@ -146,7 +155,7 @@ class BridgeOperator:
                 return reply.ok.payload.to_bytes().decode()
             reason = reply.err.payload.to_bytes().decode()
             if reason.startswith(("refused:", "stale:")):
-                raise RemoteRefusal(f"{topic.value} {text!r}: {reason}")
+                raise RemoteRefusal(topic, text, reason)
             raise HuboLadderError(f"{topic.value} {text!r}: {reason}")
         raise HuboLadderError(f"{topic.value} {text!r}: no answer from the robot bridge in "
                               f"{self.timeout_s:g} s (not connected, or this operator may "

@@ -2,6 +2,7 @@
 
     hubo-init [--instance NAME] [--robot R] [--host 127.0.0.1] [--port 8080]
               [--rate-hz 10] [--camera none|sim] [--ladder drc] [--camera-fps 4]
+              [--bridge tls/HOST:PORT --tls-dir DIR --name NAME]
 
 Serves one page (nicegui) that shows every joint's position, reference, error, mode and
 board state (faults red, warnings amber), the F/T sensors, IMUs and battery, refreshed
@@ -11,10 +12,17 @@ any hubo-console command (goto, comp, kp, kd, maxPWM); hubo-neck's keys. Every r
 shown with its reason. ``--camera sim`` renders the head camera of a sim daemon (started
 with the same ``--ladder`` and ``--robot``) ``--camera-fps`` times a second.
 
+``--bridge`` serves the same page on the operator's computer for a robot behind
+``hubo-bridge robot``: the state comes from the bridge, and every button, key and command
+goes through it, answered by the robot's local tools (the bridge refuses goto, comp and
+status over the network). ``--tls-dir`` and ``--name`` are hubo-bridge operator's: this
+operator's certificate, which the robot must list with ``--allow-writer``.
+
 Open http://HOST:PORT/ in a browser. Ctrl-C or SIGTERM stops the server.
 
-Exit codes: 0 stopped, 1 failed while running, 2 bad input (an option out of its range,
-named with the range): nothing is served.
+Exit codes: 0 stopped, 1 failed (no robot bridge to connect to, or failed while
+running), 2 bad input (an option out of its range, named with the range; a bad option
+combination): nothing is served.
 """
 
 from __future__ import annotations
@@ -22,9 +30,15 @@ from __future__ import annotations
 import argparse
 import logging
 import sys
+from typing import TYPE_CHECKING
 
 from daemon.console import add_daemon_options
+from daemon.remote.cli import add_operator_options, operator_endpoint_and_tls
 from robot.errors import InputError, parse_finite, run_cli
+
+if TYPE_CHECKING:
+    from daemon.remote.session_config import TlsFiles
+    from daemon.station.link import StationLink
 
 __all__ = ["CAMERA_FPS_RANGE_HZ", "RATE_RANGE_HZ", "main"]
 
@@ -59,7 +73,49 @@ def _parser() -> argparse.ArgumentParser:
                    help="--camera sim: the sim daemon's ladder (name or spec file; drc)")
     p.add_argument("--camera-fps", default="4", metavar="HZ",
                    help="--camera sim: frames a second (default 4, allowed [1, 10]) [Hz]")
+    bridge = p.add_argument_group(
+        "through hubo-bridge", "the robot's daemon behind `hubo-bridge robot`; --instance "
+        "is its instance there, and its bridge's --robot sets the limits")
+    add_operator_options(bridge, "--bridge", required=False)
     return p
+
+
+def _bridge_options(args: argparse.Namespace) -> tuple[str, TlsFiles] | None:
+    """The robot bridge's endpoint and this operator's `TlsFiles` with ``--bridge``; None
+    without it (the daemon's channels here). Checked before anything is opened.
+
+    Raises:
+        InputError: ``--bridge`` without ``--tls-dir`` and ``--name``, or they without it;
+            a bad endpoint or a missing TLS file.
+    """
+    certificate = [f for f, v in (("--tls-dir", args.tls_dir), ("--name", args.name)) if v]
+    if args.bridge is None:
+        if certificate:
+            raise InputError(f"{' and '.join(certificate)} refused without --bridge: they "
+                             "name the operator's certificate for the robot bridge; "
+                             "nothing served")
+        return None
+    if len(certificate) < 2:
+        raise InputError("--bridge needs --tls-dir and --name (this operator's certificate, "
+                         "as hubo-bridge operator takes them); nothing served")
+    return operator_endpoint_and_tls(args, "--bridge")
+
+
+def _open_link(args: argparse.Namespace, bridge: tuple[str, TlsFiles] | None
+               ) -> StationLink:
+    """The page's state source and command sink: the robot bridge with ``--bridge``
+    (`_bridge_options`), else the daemon's channels here.
+
+    Raises:
+        HuboLadderError: no robot bridge to connect to.
+    """
+    if bridge is None:
+        from daemon.station.local_link import LocalLink
+
+        return LocalLink(args.instance, args.robot)
+    from daemon.station.bridge_link import BridgeLink
+
+    return BridgeLink(*bridge, args.instance)
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -68,18 +124,19 @@ def _run(args: argparse.Namespace) -> int:
     port = _in_range("--port", args.port, PORT_RANGE, "")
     if port != int(port):
         raise InputError(f"--port {args.port} refused: a whole number in [1, 65535]")
+    bridge = _bridge_options(args)
     from nicegui import app, ui
 
-    from daemon.station.commands import StationCommands
     from daemon.station.head_camera import SimHeadCamera
     from daemon.station.page import Station, build_page
 
-    camera = SimHeadCamera(args.instance, args.ladder, args.robot, fps).start() \
-        if args.camera == "sim" else None
-    station = Station(args.instance, StationCommands(args.instance, args.robot), rate_hz,
-                      camera)
+    camera = SimHeadCamera(args.ladder, args.robot, fps) if args.camera == "sim" else None
+    link = _open_link(args, bridge)
+    if camera is not None:
+        camera.start(link.latest_state)
+    station = Station(link, rate_hz, camera)
     app.on_shutdown(station.close)
-    print(f"hubo-init: http://{args.host}:{int(port)}/ for instance {args.instance!r}, "
+    print(f"hubo-init: http://{args.host}:{int(port)}/ for {link.where}, "
           f"{rate_hz:g} Hz, camera {args.camera}", file=sys.stderr, flush=True)
     ui.run(lambda: build_page(station), host=args.host, port=int(port), title="hubo-init",
            reload=False, show=False, show_welcome_message=False, favicon="🪜")

@@ -25,6 +25,7 @@ import os
 import sys
 import threading
 import time
+from collections.abc import Callable
 
 import numpy as np
 
@@ -91,10 +92,10 @@ class _Scene:
 
 
 class SimHeadCamera:
-    """A thread that renders the head camera at ``fps`` from daemon ``instance``'s state.
+    """A thread that renders the head camera at ``fps`` from the newest state sample
+    (`start` names where it comes from).
 
     Args:
-        instance: the sim daemon's channel namespace.
         ladder: the sim daemon's ``--ladder`` (name or spec file).
         robot: the sim daemon's ``--robot``.
         fps: frames a second [Hz].
@@ -107,11 +108,11 @@ class SimHeadCamera:
         InputError: an unknown ladder (the scene is built here, at the edge).
     """
 
-    def __init__(self, instance: str, ladder: str = "drc", robot: str = "drc-hubo",
-                 fps: float = 4.0):
+    def __init__(self, ladder: str = "drc", robot: str = "drc-hubo", fps: float = 4.0):
         if "mujoco" not in sys.modules:
             os.environ.setdefault("MUJOCO_GL", "egl")
-        self.instance, self.fps = instance, fps
+        self.fps = fps
+        self._latest_state: Callable[[], np.ndarray | None] = lambda: None
         self._scene = _Scene(ladder, robot)
         self.error: str | None = None
         self.frames = 0
@@ -121,7 +122,11 @@ class SimHeadCamera:
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._run, name="head-camera", daemon=True)
 
-    def start(self) -> SimHeadCamera:
+    def start(self, latest_state: Callable[[], np.ndarray | None]) -> SimHeadCamera:
+        """Render from ``latest_state`` (the page's state source: the sim daemon's channel,
+        or a sim robot's samples through the bridge), which returns the newest ``state``
+        sample or None."""
+        self._latest_state = latest_state
         self._thread.start()
         return self
 
@@ -143,8 +148,6 @@ class SimHeadCamera:
         import mujoco
         from PIL import Image
 
-        from daemon.channels import open_channel
-
         scene = self._scene
         try:
             renderer = mujoco.Renderer(scene.model, height=FRAME_SIZE_PX[1],
@@ -158,12 +161,11 @@ class SimHeadCamera:
         option.geomgroup[:] = 1  # the robot's geoms are in group 3
         flags = renderer.scene.flags  # shadows and reflections cost 4/5 of a frame's CPU
         flags[mujoco.mjtRndFlag.mjRND_SHADOW] = flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = 0
-        state = open_channel("state", self.instance)
         period_s = 1.0 / self.fps
         try:
             while not self._stop.is_set():
                 t0 = time.monotonic()
-                s = state.read_latest()
+                s = self._latest_state()
                 if s is not None and time.monotonic() - self._asked_s < WATCHED_FOR_S:
                     scene.pose(np.asarray(s["pos"]))
                     renderer.update_scene(scene.data, camera=HEAD_CAMERA, scene_option=option)
@@ -176,4 +178,3 @@ class SimHeadCamera:
                 self._stop.wait(max(0.0, period_s - (time.monotonic() - t0)))
         finally:
             renderer.close()
-            state.close()

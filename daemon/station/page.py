@@ -2,27 +2,27 @@
 of every command with its outcome.
 
 Only layout and wiring live here. The rows come from `daemon.station.state_view`, the
-commands from `daemon.station.commands`, the frames from `daemon.station.head_camera`.
-Each browser gets its own page; they share one `Station` (the channels and commands of
-the process). nicegui is imported only by `build_page`, so importing `daemon` stays light.
+state and the commands from a `daemon.station.link.StationLink` (the daemon's channels
+here, or the robot through hubo-bridge: one page for both), the frames from
+`daemon.station.head_camera`. Each browser gets its own page; they share one `Station`
+(the link of the process). nicegui is imported only by `build_page`, so importing
+`daemon` stays light.
 """
 
 from __future__ import annotations
 
 import base64
-import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
-from daemon.station.commands import Outcome, StationCommands
 from daemon.station.head_camera import SimHeadCamera
+from daemon.station.link import Outcome, StationLink
 from daemon.station.state_view import Severity, joint_rows, sensor_rows, summary_line
 from robot.joints import JOINT_NAMES
 
 __all__ = ["Station", "build_page"]
 
-STALE_AFTER_S = 0.5  # a state sample older than this: no daemon is ticking [s]
 NECK_KEY_LAYOUT = (("q", "w", "e"), ("a", "s", "d"), ("c",))
 NECK_KEYS = "wsadqec"
 
@@ -48,42 +48,19 @@ class Station:
     """What one ``hubo-init`` process shares between its pages.
 
     Attributes:
-        instance: the daemon's channel namespace.
-        commands: the command handlers.
+        link: the state source and command sink (local channels, or the bridge).
         rate_hz: how often a page refreshes the state [Hz].
         camera: the simulated head camera, or None (on the robot: no image channel).
     """
 
-    instance: str
-    commands: StationCommands
+    link: StationLink
     rate_hz: float
     camera: SimHeadCamera | None = None
-    _channels: dict = field(default_factory=dict)
-
-    def channel(self, name: str):
-        """The page's own reader of channel ``name`` (opened once)."""
-        if name not in self._channels:
-            from daemon.channels import open_channel
-
-            self._channels[name] = open_channel(name, self.instance)
-        return self._channels[name]
-
-    def read(self) -> tuple[np.ndarray | None, np.ndarray | None]:
-        """The newest state sample, and the ``mode`` of the newest ``ref`` sample written
-        since the daemon started (None when none was: the daemon holds)."""
-        s = self.channel("state").read_latest()
-        if s is None:
-            return None, None
-        r = self.channel("ref").read_latest()
-        start_ns = int(s["time_ns"]) - round(float(s["time_s"]) * 1e9)
-        return s, (r["mode"] if r is not None and int(r["time_ns"]) >= start_ns else None)
 
     def close(self) -> None:
         if self.camera is not None:
             self.camera.close()
-        self.commands.close()
-        for c in self._channels.values():
-            c.close()
+        self.link.close()
 
 
 def _fmt(rad: float) -> str:
@@ -105,8 +82,8 @@ def build_page(station: Station) -> None:
     """Lay out one browser's page and start its refresh timers."""
     from nicegui import run, ui
 
-    commands = station.commands
-    ui.page_title(f"hubo-init · {station.instance}")
+    commands = station.link
+    ui.page_title(f"hubo-init · {station.link.instance}")
 
     def show(outcome: Outcome) -> None:
         log.push(outcome.line(), classes="" if outcome.ok else "text-negative")
@@ -119,7 +96,7 @@ def build_page(station: Station) -> None:
             show(outcome)
 
     with ui.row().classes("w-full items-center"):
-        ui.label(f"hubo-init · instance {station.instance}").classes("text-h6")
+        ui.label(f"hubo-init · {station.link.where}").classes("text-h6")
         summary = ui.label("waiting for the daemon's state").classes("text-mono")
     with ui.row().classes("w-full no-wrap items-start"):
         joints = ui.table(columns=COLUMNS, rows=[], row_key="name", pagination=0)
@@ -183,17 +160,18 @@ def build_page(station: Station) -> None:
     ui.keyboard(on_key=on_key)
 
     def refresh() -> None:
-        state, ref_mode = station.read()
-        age_s = (time.monotonic_ns() - int(state["time_ns"])) / 1e9 if state is not None \
-            else float("inf")
-        if state is None or age_s > STALE_AFTER_S:
-            summary.set_text(f"no hubo-daemon is ticking on instance {station.instance!r}")
+        reading = station.link.read()
+        age_s = float("inf") if reading is None else reading.age_s()
+        if age_s > station.link.stale_after_s:
+            since = "yet" if reading is None else f"for {age_s:.0f} s"
+            summary.set_text(f"no state {since} from {station.link.where}: "
+                             f"{station.link.silent_means}")
             summary.classes(replace="text-mono text-negative")
             return
-        summary.set_text(summary_line(state, age_s))
+        summary.set_text(summary_line(reading.state, age_s))
         summary.classes(replace="text-mono")
-        joints.rows = _table_rows(state, ref_mode)
-        sensors.rows = _sensor_rows(state)
+        joints.rows = _table_rows(reading.state, reading.ref_mode)
+        sensors.rows = _sensor_rows(reading.state)
 
     ui.timer(1.0 / station.rate_hz, refresh)
 
