@@ -1,6 +1,6 @@
 """``make bench``: run every benchmark and print its figures against the targets.
 
-Usage: ``python -m bench [--only planner,sim,tracking,daemon,channels,can,batch,bridge]
+Usage: ``python -m bench [--only planner,sim,tracking,daemon,channels,can,batch,bridge,station]
 [--json FILE]``.
 Figures are measurements on this machine; a target missed is shown, not hidden.
 """
@@ -13,7 +13,8 @@ import json
 import sys
 import time
 
-SUITES = ("planner", "sim", "tracking", "daemon", "channels", "can", "batch", "bridge")
+SUITES = ("planner", "sim", "tracking", "daemon", "channels", "can", "batch", "bridge",
+          "station")
 
 
 def main(argv: list[str] | None = None) -> int:
