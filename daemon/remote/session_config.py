@@ -62,11 +62,14 @@ _NO_SCOUTING = {"multicast": {"enabled": False}, "gossip": {"enabled": False}}
 
 def _mutual_tls(tls: TlsFiles, side: str) -> dict:
     """The ``transport`` section: TLS with ``tls``'s files on the ``listen`` or ``connect``
-    side, the peer's certificate checked against the same CA."""
+    side, the peer's certificate checked against the same CA. Zenoh's shared-memory
+    transport is off: the bridge's peers are on other computers, and it left a segment
+    in /dev/shm behind every session."""
     return {"link": {"tls": {"root_ca_certificate": str(tls.ca_pem),
                              f"{side}_certificate": str(tls.cert_pem),
                              f"{side}_private_key": str(tls.key_pem),
-                             "enable_mtls": True}}}
+                             "enable_mtls": True}},
+            "shared_memory": {"enabled": False}}
 
 
 def robot_config(listen: str, tls: TlsFiles, instance: str,
