@@ -64,8 +64,9 @@ def test_plan_comparison_legend_has_the_limits_and_a_long_title_fits(monkeypatch
                "(plan +6.2), RHP +5.7 N·m (plan -12.1); body 2.5 cm and 0.8° off")
     comparison = SimpleNamespace(joints=joints, summary=lambda: summary)
     monkeypatch.setattr(plan_compare, "planned_torque_history",
-                        lambda run, traj, ladder, names: (run.log.time_s[::10], np.zeros(
-                            (len(run.log.time_s[::10]), len(names)))))
+                        lambda run, traj, ladder, names, verifier=None: (
+                            run.log.time_s[::10],
+                            np.zeros((len(run.log.time_s[::10]), len(names)))))
     fig = artifacts.plan_comparison_figure(run, comparison, None, None)
     assert _legend(fig) == ["MuJoCo", "plan (torque LP)", "torque limit (±)"]
     assert "At line 300282 against the plan" in fig.get_suptitle()

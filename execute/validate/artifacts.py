@@ -88,15 +88,17 @@ def write_tracking_plots(run, out_dir: str | os.PathLike) -> list[Path]:
 
 
 def plan_comparison_figure(run, comparison, trajectory_rad: np.ndarray, ladder,
-                           joints: int = 4):
+                           joints: int = 4, verifier=None):
     """Simulated against planned torque [N·m] vs time for the ``joints`` joints that
-    departed most from the plan (`execute.validate.plan_compare`), with their limits."""
+    departed most from the plan (`execute.validate.plan_compare`), with their limits.
+    ``verifier``: the plan's verifier, if the caller has one (its stances are reused)."""
     from execute.validate.plan_compare import planned_torque_history
 
     plt = _pyplot()
     names = [j.joint for j in comparison.joints[:joints]]
     limits = {j.joint: j.limit_nm for j in comparison.joints}
-    times, planned = planned_torque_history(run, trajectory_rad, ladder, names)
+    times, planned = planned_torque_history(run, trajectory_rad, ladder, names,
+                                            verifier=verifier)
     lg = run.log
     fig, axes = plt.subplots(len(names), 1, sharex=True, figsize=(8, 2.2 * len(names) + 0.8),
                              squeeze=False, layout="constrained")
@@ -120,10 +122,11 @@ def plan_comparison_figure(run, comparison, trajectory_rad: np.ndarray, ladder,
 
 
 def write_plan_comparison_plot(run, comparison, trajectory_rad: np.ndarray, ladder,
-                               path: str | os.PathLike, joints: int = 4) -> Path:
+                               path: str | os.PathLike, joints: int = 4,
+                               verifier=None) -> Path:
     """``plan_vs_sim.png`` (`plan_comparison_figure`)."""
     plt = _pyplot()
-    fig = plan_comparison_figure(run, comparison, trajectory_rad, ladder, joints)
+    fig = plan_comparison_figure(run, comparison, trajectory_rad, ladder, joints, verifier)
     out = Path(path)
     out.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(out, dpi=90)

@@ -196,6 +196,7 @@ def _run(args: argparse.Namespace) -> int:
     from execute.validate.simulate import SimulationOptions, simulate
     from execute.view.cli import display_every_s
     from ladders.loader import load_ladder
+    from planner.verify.check import plan_verifier
     from robot.plan_sidecar import check_line_count, read_sidecar, sidecar_path
     from robot.progress import ProgressReporter
     from robot.trajectory_file import read_trajectory
@@ -226,7 +227,8 @@ def _run(args: argparse.Namespace) -> int:
         run = simulate(traj, sidecar, ladder, opts, robot,
                        progress=lambda sim_s, total_s: progress.update(sim_s, total=total_s))
     metrics = compute_metrics(run)
-    comparison = compare_with_plan(run, traj, ladder)
+    verifier = plan_verifier(sidecar, ladder, robot)  # one for every comparison below
+    comparison = compare_with_plan(run, traj, ladder, verifier)
     result = result_json(run, metrics, str(plan), comparison)
     print("\n".join(verdict_lines(run, metrics, sidecar)))
     if run.motion is not None:
@@ -240,7 +242,7 @@ def _run(args: argparse.Namespace) -> int:
         from execute.view.run_recording import write_run_recording
 
         layers = PlanLayers(display_every_s=record_every_s)
-        print(f"wrote {write_run_recording(run, traj, ladder, args.record, layers)}")
+        print(f"wrote {write_run_recording(run, traj, ladder, args.record, layers, verifier)}")
     if args.plots or args.video:
         from execute.validate.artifacts import (
             RenderingUnavailable,
@@ -255,7 +257,8 @@ def _run(args: argparse.Namespace) -> int:
                     print(f"wrote {p}")
                 if comparison is not None:
                     path = write_plan_comparison_plot(run, comparison, traj, ladder,
-                                                      Path(args.plots) / "plan_vs_sim.png")
+                                                      Path(args.plots) / "plan_vs_sim.png",
+                                                      verifier=verifier)
                     print(f"wrote {path}")
                 print(f"wrote {write_snapshot_strip(run, Path(args.plots) / 'snapshots.png')}")
             if args.video:

@@ -141,7 +141,8 @@ class GripAgreement:
                 "departure": round(self.departure, 3)}
 
 
-def grip_agreement(run, trajectory_rad: np.ndarray, ladder) -> tuple[GripAgreement, ...]:
+def grip_agreement(run, trajectory_rad: np.ndarray, ladder, verifier=None
+                   ) -> tuple[GripAgreement, ...]:
     """Per segment and held hand, the plan's grip load (check-plan's torque LP, the
     contact model's limits) against the latch's (`GraspLatch.load_history`), at the
     latch's sample nearest the segment's middle."""
@@ -168,7 +169,7 @@ def grip_agreement(run, trajectory_rad: np.ndarray, ladder) -> tuple[GripAgreeme
         return ()
     axis = LadderGeometry(ladder).ladder_direction
     plans = planned_loads(trajectory_rad, run.sidecar, ladder, [p[2] for p in picks],
-                          run.board.robot)
+                          run.board.robot, verifier)
     out = []
     for (k, limb, line, t, f, tq), plan in zip(picks, plans, strict=True):
         if plan.torque is None or not plan.torque.equilibrium:
@@ -199,14 +200,17 @@ def _body_contact_force(model: mujoco.MjModel, data: mujoco.MjData, body: int) -
     return total
 
 
-def compare_with_plan(run, trajectory_rad: np.ndarray, ladder) -> PlanComparison | None:
+def compare_with_plan(run, trajectory_rad: np.ndarray, ladder, verifier=None
+                      ) -> PlanComparison | None:
     """Compare the end of ``run`` (an `execute.validate.simulate.SimulationRun`) with the plan's
-    account of its line; None when the plan places no body there (no foot held)."""
-    from planner.verify.check import planned_loads
+    account of its line; None when the plan places no body there (no foot held).
+    ``verifier``: the plan's `planner.verify.check.PlanVerifier`, built here if None."""
+    from planner.verify.check import plan_verifier, planned_loads
 
     board, sidecar = run.board, run.sidecar
+    verifier = verifier or plan_verifier(sidecar, ladder, board.robot)
     line = int(run.log.line_index[-1]) + 1
-    plan = planned_loads(trajectory_rad, sidecar, ladder, [line], board.robot)[0]
+    plan = planned_loads(trajectory_rad, sidecar, ladder, [line], board.robot, verifier)[0]
     if plan.torque is None or not plan.torque.equilibrium:
         return None
     m, d = board.model, board.data
@@ -235,11 +239,12 @@ def compare_with_plan(run, trajectory_rad: np.ndarray, ladder) -> PlanComparison
         holds[limb] = (f.sum(axis=0), sim)
     return PlanComparison(line, board.time_s, d.qpos[:3] - plan.base_pose[:3, 3], turn,
                           tuple(loads[:JOINTS_LISTED]), holds, plan.torque.max_ratio,
-                          grip_agreement(run, trajectory_rad, ladder))
+                          grip_agreement(run, trajectory_rad, ladder, verifier))
 
 
 def planned_torque_history(run, trajectory_rad: np.ndarray, ladder, joints: list[str],
-                           every_s: float = 0.5) -> tuple[np.ndarray, np.ndarray]:
+                           every_s: float = 0.5, verifier=None
+                           ) -> tuple[np.ndarray, np.ndarray]:
     """The plan's torques of ``joints`` along the run, for plotting against the
     simulation's: (times [s], torques (k, len(joints)) [N·m]), a line every ``every_s``
     of the run (NaN where the plan places no body)."""
@@ -250,7 +255,7 @@ def planned_torque_history(run, trajectory_rad: np.ndarray, ladder, joints: list
     lines = [int(log.line_index[k]) + 1 for k in ticks]
     torques = np.full((len(ticks), len(joints)), np.nan)
     for row, plan in enumerate(planned_loads(trajectory_rad, run.sidecar, ladder, lines,
-                                             run.board.robot)):
+                                             run.board.robot, verifier)):
         if plan.torque is not None and plan.torque.equilibrium:
             torques[row] = [plan.torque.torque(n) for n in joints]
     return log.time_s[ticks], torques

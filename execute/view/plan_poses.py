@@ -79,16 +79,15 @@ class PlanKinematics:
     """
 
     def __init__(self, trajectory_rad: np.ndarray, sidecar: PlanSidecar, ladder: LadderSpec,
-                 where: str = "plan"):
+                 where: str = "plan", verifier=None):
         from ladders.scene import build_scene
-        from planner.verify.check import PlanVerifier
+        from planner.verify.check import plan_verifier
         from robot.plan_sidecar import segment_of_lines
 
         self.trajectory_rad = trajectory_rad
         self.sidecar = sidecar
         self.segment_of_row = segment_of_lines(sidecar, where)
-        self.verifier = PlanVerifier(ladder, sidecar.robot,
-                                  sidecar.metrics.get("arm_strategy", "position"))
+        self.verifier = verifier or plan_verifier(sidecar, ladder)
         self.model = build_scene(ladder, sidecar.robot).compile()
         addresses = joint_qpos_addresses(self.model)
         self._columns = np.array([JOINT_NAMES.index(n) for n in addresses])

@@ -143,7 +143,7 @@ def _log_series(rec: rr.RecordingStream, run, step: int) -> None:
 
 
 def record_run(rec: rr.RecordingStream, run, trajectory_rad: np.ndarray, ladder,
-               layers: PlanLayers | None = None) -> None:
+               layers: PlanLayers | None = None, verifier=None) -> None:
     """Log a simulated run (an `execute.validate.simulate.SimulationRun` that kept its
     qpos) beside its plan's ghost.
 
@@ -151,6 +151,8 @@ def record_run(rec: rr.RecordingStream, run, trajectory_rad: np.ndarray, ladder,
         trajectory_rad: the plan's (N, 40) lines [rad].
         ladder: the ladder the plan was made for (the ghost's frame).
         layers: what to draw of the plan, and how densely.
+        verifier: the plan's `planner.verify.check.PlanVerifier`, if the caller has one
+            (its stances' support regions are reused); built here if None.
     """
     layers = layers or PlanLayers()
     lg = run.log
@@ -165,7 +167,7 @@ def record_run(rec: rr.RecordingStream, run, trajectory_rad: np.ndarray, ladder,
     pos, quat = body_poses(model, lg.qpos[ticks])
     log_robot(rec, "world/sim/robot", robot_bodies(model, meshes), times, pos, quat)
     log_track(rec, "world/sim/com", times, lg.com_m[ticks], SIM_COM_RGB)
-    kin = PlanKinematics(trajectory_rad, run.sidecar, ladder)
+    kin = PlanKinematics(trajectory_rad, run.sidecar, ladder, verifier=verifier)
     log_plan(rec, kin, lg.line_index[ticks].astype(int), times,
              _first_time_of_row(lg.line_index, lg.time_s), layers, tint_rgba=GHOST_RGBA)
     _log_grips(rec, run, model)
@@ -176,9 +178,9 @@ def record_run(rec: rr.RecordingStream, run, trajectory_rad: np.ndarray, ladder,
 
 
 def write_run_recording(run, trajectory_rad: np.ndarray, ladder, path: str | Path,
-                        layers: PlanLayers | None = None) -> Path:
+                        layers: PlanLayers | None = None, verifier=None) -> Path:
     """`record_run` into the file ``path`` (``.rrd``); returns the path."""
     rec = open_file(path)
-    record_run(rec, run, trajectory_rad, ladder, layers)
+    record_run(rec, run, trajectory_rad, ladder, layers, verifier)
     rec.flush()
     return Path(path)

@@ -64,7 +64,7 @@ if TYPE_CHECKING:
 __all__ = ["CHECKS", "CLEARANCE_EVERY_LINES", "CheckResult", "ContactLoad", "HOLD_TOL_M",
            "PlanVerifier", "PlannedLoad",
            "allowed_contacts", "check_plan", "contact_hold", "contact_wrench_utilisation",
-           "planned_loads"]
+           "plan_verifier", "planned_loads"]
 
 log = logging.getLogger(__name__)
 
@@ -430,15 +430,27 @@ class PlannedLoad:
     torque: TorqueCheck | None
 
 
+def plan_verifier(sidecar: PlanSidecar, spec, robot: str | None = None) -> PlanVerifier:
+    """The verifier of a plan: its robot and ladder, its gripping arms driven as the plan's
+    arm strategy drives them (rigid for a sidecar from before it was recorded)."""
+    return PlanVerifier(spec, robot or sidecar.robot,
+                        sidecar.metrics.get("arm_strategy", "position"))
+
+
 def planned_loads(traj_rad: np.ndarray, sidecar: PlanSidecar, spec, lines: Sequence[int],
-                  robot: str | None = None) -> list[PlannedLoad]:
+                  robot: str | None = None, verifier: PlanVerifier | None = None
+                  ) -> list[PlannedLoad]:
     """The configuration and the torque LP of each of ``lines`` (1-based), as check-plan
-    computes them: what a simulation of the plan is compared against."""
+    computes them: what a simulation of the plan is compared against.
+
+    ``verifier`` (`plan_verifier`) keeps the stances it has built; callers that ask about
+    the same plan several times pass one, so that each stance's support region is
+    computed once.
+    """
     from planner.statics.torque_lp import torque_feasibility
 
     seg_of = segment_of_lines(sidecar, "plan")
-    v = PlanVerifier(spec, robot or sidecar.robot, sidecar.metrics.get("arm_strategy",
-                                                                     "position"))
+    v = verifier or plan_verifier(sidecar, spec, robot)
     out = []
     for line in lines:
         si = int(seg_of[line - 1])
