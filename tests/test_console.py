@@ -14,7 +14,7 @@ sys.path.insert(0, str(Path(__file__).parent))
 
 from fake_daemon import running_daemon  # noqa: E402
 
-from daemon.channels import open_channel  # noqa: E402
+from daemon.channels import cleanup_stale, open_channel  # noqa: E402
 from daemon.console import main as console_main  # noqa: E402
 from robot.joints import JOINT_INDEX  # noqa: E402
 
@@ -99,3 +99,4 @@ def test_no_daemon_is_a_one_line_failure(capsys):
     assert console_main(["--instance", "console-nobody", "-c", "statusAll"]) == 1
     err = capsys.readouterr().err
     assert err.strip() == "hubo-console: no hubo-daemon is ticking on instance 'console-nobody'"
+    cleanup_stale("console-nobody")  # the channels the console opened to look

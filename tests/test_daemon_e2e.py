@@ -23,8 +23,9 @@ sys.path.insert(0, str(Path(__file__).parent / "fixtures"))
 
 from make_fixture import cached_reach_fixture  # noqa: E402
 
-from daemon.channels import open_channel  # noqa: E402
+from daemon.channels import cleanup_stale, open_channel  # noqa: E402
 from daemon.console import main as console_main  # noqa: E402
+from daemon.player_control import player_lock_file  # noqa: E402
 from daemon.state_log import read_state_log  # noqa: E402
 from daemon.structs import (  # noqa: E402
     BOARD_CMD_DTYPE,
@@ -109,11 +110,14 @@ class Daemon:
         return read_state_log(self.log)
 
     def close(self) -> None:
+        """Stop the daemon and leave nothing of this instance in /dev/shm."""
         if self.proc is not None and self.proc.poll() is None:
             self.proc.kill()
             self.proc.communicate()
         if self.state is not None:
             self.state.close()
+        cleanup_stale(self.instance)
+        player_lock_file(self.instance).unlink(missing_ok=True)
 
 
 def play(instance: str, *args: str, wait: bool = True):
@@ -158,6 +162,7 @@ def test_sim_daemon_plays_the_fixture_with_automatic_modes(plan, tmp_path):
         assert r.returncode == 2 and f"{bad}:7:" in r.stderr
         ref = open_channel("ref", d.instance)
         assert ref.read_latest() is None  # nothing was ever sent
+        ref.close()
         # not homed yet: refused
         r = play(d.instance, "-n", str(plan), "-i")
         assert r.returncode == 1 and "not homed" in r.stderr
@@ -168,6 +173,7 @@ def test_sim_daemon_plays_the_fixture_with_automatic_modes(plan, tmp_path):
         c = new_sample(BOARD_CMD_DTYPE)
         c["type"], c["joint"], c["dvalues"][:3] = BoardCommandType.SET_GAINS, 12, (80, 0, 9)
         cmd.write(c)
+        cmd.close()
         time.sleep(0.1)
         r = play(d.instance, "-n", str(plan), "-i")
         assert r.returncode == 0, r.stderr

@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from daemon.channels import cleanup_stale
 from execute.play.cli import main as play_main
 from execute.play.lock import PlayerBusyError, PlayerLock, player_lock_path
 from robot.trajectory_file import write_trajectory
@@ -26,6 +27,7 @@ def instance():
     name = f"lock-{os.getpid()}-{time.monotonic_ns() % 10**9}"
     yield name
     player_lock_path(name).unlink(missing_ok=True)
+    cleanup_stale(name)  # the channels a player opened to wait for a daemon
 
 
 @pytest.fixture
