@@ -10,9 +10,11 @@ LADDER is a bundled ladder (``drc``, ``ship``, ``stair``) or a spec file. A prog
 bar follows the primitives and rungs; a table summarises each primitive at the end.
 The same seed gives the same trajectory file, byte for byte.
 
-Exit codes: 0 a plan was written; 1 no plan (``no plan: <primitive> at rung <k>:
-<reason>``), or it could not be timed within the joint limits; 2 bad input (the message
-names the file, field or option).
+Exit codes: 0 a plan was written; 1 no plan (``no plan: <primitive> at rung <k> (<what
+it does>): <why the search stopped>``, then that step's failed samples grouped by
+reason, in cm, degrees and torque ratios; ``-v`` adds the solver's figures), or it could
+not be timed within the joint limits; 2 bad input (the message names the file, field or
+option).
 """
 
 from __future__ import annotations
@@ -145,6 +147,22 @@ def _write_plots(args: argparse.Namespace, result, planner, spec, out, err, on_o
         err.print(f"plan-ladder: no snapshot strip: {exc}", markup=False)
 
 
+def _no_plan_message(exc, planner, spec, current, time_limit_s: float) -> str:
+    """The user's ``no plan:`` message for a `PlanningFailed` or `TimeLimitExceeded`
+    (`planner.failure_report`); the search's own text, with the solver's figures, is
+    logged at ``-v``."""
+    from planner.search import PlanningFailed
+
+    log.info("search stopped: %s", exc)
+    if isinstance(exc, PlanningFailed):
+        progress, stop = exc.progress, exc.stop
+    else:
+        progress, stop = planner.progress, f"time limit of {time_limit_s:g} s reached"
+    if progress is None:  # stopped before the search began
+        return f"no plan: {current.primitive.name} at rung {current.rung}: {stop}"
+    return progress.explain(spec, stop)
+
+
 def _plan(args: argparse.Namespace, err) -> int:
     from ladders.loader import load_ladder
     from planner.output import write_plan
@@ -185,9 +203,7 @@ def _plan(args: argparse.Namespace, err) -> int:
             result = planner.plan(top_rung=top, progress=on_step)
     except (PlanningFailed, TimeLimitExceeded) as exc:
         search.finish("no plan")
-        step, reason = ((exc.step, exc.reason) if isinstance(exc, PlanningFailed) else
-                        (current[0], f"time limit of {args.time_limit:g} s reached"))
-        err.print(f"no plan: {step.primitive.name} at rung {step.rung}: {reason}",
+        err.print(_no_plan_message(exc, planner, spec, current[0], args.time_limit),
                   markup=False, highlight=False, soft_wrap=True)
         return 1
     # Not "done": timing, checking and writing the plan may take minutes more.

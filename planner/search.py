@@ -26,8 +26,9 @@ from planner.configuration.collision import CollisionModel
 from planner.configuration.feasible import FeasibleSearchStats, SearchTarget, find_feasible
 from planner.configuration.ik import IKConfig, solve_ik
 from planner.configuration.kinematics import HuboKinematics
-from planner.configuration.validity import FeasibilityChecker
+from planner.configuration.validity import FeasibilityChecker, Verdict
 from planner.contacts import Hold, Stance
+from planner.failure_report import SampleFailure, explain_no_plan
 from planner.holds import FOOT_COP_MARGIN_M, FOOT_FRICTION_SHARE, GRIP_STYLES, make_hold
 from planner.paths.interpolation import (
     InterpolationError,
@@ -121,12 +122,22 @@ class PlannerConfig:
 
 
 class PlanningFailed(HuboLadderError):
-    """No plan was found; names the primitive and rung that failed."""
+    """No plan was found; names the primitive and rung where the search stopped.
 
-    def __init__(self, step: Step, reason: str):
+    Attributes:
+        step: the step where the search stopped.
+        reason: why, with the last sample's solver figures (for logs and batch records).
+        stop: why the search stopped, in a user's words (`explain_no_plan`).
+        progress: how far the search got, with every step's failed samples.
+    """
+
+    def __init__(self, step: Step, reason: str, stop: str = "",
+                 progress: SearchProgress | None = None):
         super().__init__(f"no feasible {step.primitive.name} at rung {step.rung}: {reason}")
         self.step = step
         self.reason = reason
+        self.stop = stop or reason
+        self.progress = progress
 
 
 @dataclass
@@ -152,6 +163,33 @@ class StepStats:
     limb_detours: int = 0  # limb paths found by RRTConnect where the arc collided
     limb_detour_tries: int = 0
     leg_clearance_m: float = np.nan  # the legs' clearance the step was found with [m]
+    # Every failed sample, over all visits of the step: what a no-plan message explains.
+    rejected: list[SampleFailure] = field(default_factory=list, repr=False)
+
+
+@dataclass
+class SearchProgress:
+    """How far a search has got, kept up to date while it runs, so that a search stopped
+    from outside (the CLI's hard time limit) can still be explained.
+
+    Attributes:
+        steps: the climb's steps; stats: their statistics, index for index.
+        current: index of the step being searched.
+        deepest: index of the furthest step the search has reached.
+        backtracks: backtracks so far.
+    """
+
+    steps: list[Step]
+    stats: list[StepStats]
+    current: int = 0
+    deepest: int = 0
+    backtracks: int = 0
+
+    def explain(self, spec: LadderSpec, stop: str) -> str:
+        """The user's ``no plan:`` message (`explain_no_plan`) for a search stopped, for
+        the reason ``stop`` in words, at `current`."""
+        return explain_no_plan(self.steps[self.deepest], self.stats[self.deepest].rejected,
+                               spec, stop, stopped_at=self.steps[self.current])
 
 
 @dataclass
@@ -247,6 +285,7 @@ class ClimbPlanner:
             if spec.num_rungs > 1 else np.zeros(3)
         self._found: dict[tuple[str, int], tuple[int, np.ndarray]] = {}
         self._standing_pelvis_z_m = self.kin.params.pelvis_height_m  # set when standing
+        self.progress: SearchProgress | None = None  # the running or last search's
         self.ik_waypoint_config = IKConfig(
             moving_tol_m=self.ik_config.waypoint_tol_m,
             moving_angle_tol_rad=self.ik_config.waypoint_angle_tol_rad)
@@ -490,7 +529,7 @@ class ClimbPlanner:
                                        attempts=self.config.feasible_attempts, stats=fstats)
         if q_new is None:
             raise _StepRejected(StepFailure.NO_STRAIGHT_POSE,
-                               f"no straightened pose: {_why(verdict)}")
+                               f"no straightened pose: {_why(verdict)}", "straighten", verdict)
         path = self._interp(q, q_new, stance.holds, stance, self._contacts(stance.holds),
                             stats)
         return [PathSegment(step, SegmentPhase.BODY, stance.holds, (), path)], q_new, stance
@@ -513,7 +552,8 @@ class ClimbPlanner:
                                         attempts=self.config.feasible_attempts,
                                         stats=fstats, q_hint=self._hint(step, 0, attempt))
         if q_lift is None:
-            raise _StepRejected(StepFailure.NO_LIFT_OFF, f"no lift-off pose: {_why(verdict)}")
+            raise _StepRejected(StepFailure.NO_LIFT_OFF, f"no lift-off pose: {_why(verdict)}",
+                                "lift-off", verdict)
         self._remember(step, 0, q_lift)
         path = self._interp(q, q_lift, stance.holds, stance, contacts_all, stats)
         return [PathSegment(step, SegmentPhase.BODY, stance.holds, (), path)], q_lift, pelvis
@@ -575,7 +615,8 @@ class ClimbPlanner:
                 q_hint=self._hint(step, i, attempt))
             if q_next is None:
                 raise _StepRejected(StepFailure.WAYPOINT,
-                                   f"way-point {i}/{n_way - 1}: {_why(verdict)}")
+                                    f"way-point {i}/{n_way - 1}: {_why(verdict)}",
+                                    f"way-point {i}/{n_way - 1}", verdict)
             self._remember(step, i, q_next)
             try:
                 limb_path += self._interp(q_cur, q_next, support, support_stance, contacts,
@@ -598,18 +639,22 @@ class ClimbPlanner:
                             posture_rad=self.kin.posture(q), preferences=False)
         if not polished.converged:
             raise _StepRejected(StepFailure.HOLDS_NOT_MET,
-                               f"placed pose does not meet its holds: {polished!r}")
+                                f"placed pose does not meet its holds: {polished!r}", "placing",
+                                Verdict(False, f"ik {polished!r}", np.nan, np.nan,
+                                        cause=RejectCause.IK, ik_misses=polished.misses))
         correction = self.kin.joint_distance(polished.q, q)
         if correction > POLISH_MAX_RAD:
             raise _StepRejected(StepFailure.POLISH_TOO_FAR,
-                               f"placing the holds exactly moves a joint {correction:.3f} rad")
+                                f"placing the holds exactly moves a joint {correction:.3f} rad",
+                                "placing", joint_move_rad=correction)
         n = int(np.ceil(correction / self.config.resolution_rad))
         limb_path += [self.kin.interpolate(q, polished.q, (k + 1) / n) for k in range(n)]
         verdict = self.checker.check(polished.q, next_stance,
                                      self._contacts(next_stance.holds))
         if not verdict.ok:
             raise _StepRejected(StepFailure.UNSTABLE_PLACED,
-                               f"placed pose unstable in the new stance: {verdict.reason}")
+                                f"placed pose unstable in the new stance: {verdict.reason}",
+                                "placing", verdict)
         return polished.q
 
     def _close_hands(self, step: Step, q: np.ndarray, support: tuple[Hold, ...],
@@ -644,16 +689,18 @@ class ClimbPlanner:
         states: list[tuple[list[PathSegment], np.ndarray, Stance]] = [([], q0, stance0)]
         failures = [0] * len(steps)
         stats = [StepStats(s.label) for s in steps]
-        backtracks = 0
+        self.progress = reached = SearchProgress(steps, stats)
         i = 0
         while i < len(steps):
             step = steps[i]
+            reached.current, reached.deepest = i, max(reached.deepest, i)
             _, q, stance = states[-1]
             t0 = time.perf_counter()
             radius = min(self.config.hold_radius_max_m,
                          failures[i] * self.config.hold_radius_step_m)
             if time.perf_counter() - t_start > self.config.time_limit_s:
-                raise PlanningFailed(step, f"time limit of {self.config.time_limit_s:g} s reached")
+                why = f"time limit of {self.config.time_limit_s:g} s reached"
+                raise PlanningFailed(step, why, why, reached)
             relaxed = failures[i] >= self.config.leg_clearance_samples
             self.collision.set_leg_clearance(self.config.min_leg_clearance_m if relaxed
                                              else self.config.leg_clearance_m)
@@ -665,15 +712,19 @@ class ClimbPlanner:
                 stats[i].seconds += time.perf_counter() - t0
                 key = exc.cause.value
                 stats[i].failures[key] = stats[i].failures.get(key, 0) + 1
+                stats[i].rejected.append(_sample_failure(exc))
                 log.debug("%s sample %d failed: %s", step.label, failures[i], exc)
                 if failures[i] >= self.config.samples_per_step:
-                    if i == 0 or backtracks >= self.config.max_backtracks:
+                    if i == 0 or reached.backtracks >= self.config.max_backtracks:
+                        stop = ("every sample failed" if i == 0 else
+                                f"{reached.backtracks} backtracks, the most allowed")
                         raise PlanningFailed(
-                            step, f"{failures[i]} samples failed; last: {exc}") from None
+                            step, f"{failures[i]} samples failed; last: {exc}", stop,
+                            reached) from None
                     # A dead end counts as a failure of the step before, and a step that is
                     # backtracked into gets half its budget next time, so repeated dead
                     # ends reach further back instead of cycling between two steps.
-                    backtracks += 1
+                    reached.backtracks += 1
                     stats[i - 1].backtracks += 1
                     failures[i] = self.config.samples_per_step // 2
                     failures[i - 1] += self.config.samples_per_step // 5
@@ -699,8 +750,18 @@ class _StepRejected(HuboLadderError):
 
     Attributes:
         cause: what failed; its value is the key of the step's ``failures`` count.
+        failure: the same in figures, for a no-plan message (`SampleFailure`).
     """
 
-    def __init__(self, cause: StepFailure, message: str):
+    def __init__(self, cause: StepFailure, message: str, stage: str,
+                 verdict: Verdict | None = None, joint_move_rad: float = np.nan):
         super().__init__(message)
         self.cause = cause
+        self.failure = SampleFailure(cause.value, stage, verdict, joint_move_rad, message)
+
+
+def _sample_failure(exc: _StepRejected | InterpolationError) -> SampleFailure:
+    """What a failed sample's exception says, in figures (`SampleFailure`)."""
+    if isinstance(exc, _StepRejected):
+        return exc.failure
+    return SampleFailure(exc.cause.value, "path", exc.verdict, detail=str(exc))

@@ -62,7 +62,8 @@ def test_time_limit_gives_exit_1_with_primitive_and_rung(tmp_path, capsys):
     assert main(["drc", "--time-limit", "0.001", "-o", str(tmp_path / "t.traj")]) == 1
     assert time.monotonic() - t0 < 30  # the CLI stops a sample that runs past the limit
     err = capsys.readouterr().err
-    assert "no plan: placeHands at rung 0: time limit of 0.001 s reached" in err
+    assert "no plan: placeHands at rung 0 (left hand onto the left rail, right hand onto " \
+           "the right rail): time limit of 0.001 s reached" in err
     assert not (tmp_path / "t.traj").exists()
 
 
@@ -71,7 +72,9 @@ def test_unreachable_ladder_gives_exit_1(tmp_path, capsys):
     assert main([str(far), "--samples", "2", "--time-limit", "60",
                  "-o", str(tmp_path / "far.traj")]) == 1
     err = capsys.readouterr().err
-    assert "no plan: placeHands at rung 0: 2 samples failed" in err
+    assert "no plan: placeHands at rung 0 (left hand onto the left rail, right hand onto " \
+           "the right rail): every sample failed. Its 2 failed samples, by reason:" in err
+    assert "IKResult(" not in err
 
 
 @pytest.fixture

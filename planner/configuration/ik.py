@@ -12,6 +12,7 @@ from __future__ import annotations
 import logging
 import math
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 
@@ -50,13 +51,32 @@ class IKConfig:
     com_polygon_weight: float = 1e3
 
 
+class HoldMiss(NamedTuple):
+    """One hold an IK result does not meet within its tolerance: what a failure message
+    tells a user (which limb, on what, how far off)."""
+
+    limb: str  # e.g. ``left_hand``
+    target: str  # what the hold is on: ``rung_0``, ``rail_left``, ``floor``
+    position_error_m: float  # distance of the limb's frame from the hold [m]
+    angle_error_rad: float  # its turn from the hold's orientation (a hand: grip axis) [rad]
+
+
 @dataclass
 class IKResult:
+    """The configuration an IK solve ended at and how far it is from its holds.
+
+    Attributes:
+        position_error_m, angle_error_rad: the worst over every hold [m], [rad].
+        misses: the holds not met within their tolerance, per limb (empty when
+            converged), so a failure can name the limb and hold instead of only the figure.
+    """
+
     q: np.ndarray = field(repr=False)
     converged: bool
     iterations: int
     position_error_m: float
     angle_error_rad: float
+    misses: tuple[HoldMiss, ...] = ()
 
     def __repr__(self) -> str:
         return (f"IKResult({'converged' if self.converged else 'NOT converged'} in "
@@ -173,7 +193,8 @@ def solve_ik(kin: HuboKinematics, q_seed: np.ndarray, support: tuple[Hold, ...],
         if ok and it > 2:
             break
     converged = bool(np.isfinite(pos_err)) and _errors(kin, support, moving, config)[2]
-    return IKResult(kin.q, converged, it, float(pos_err), float(ang_err))
+    misses = () if converged else _misses(kin, support, moving, config)
+    return IKResult(kin.q, converged, it, float(pos_err), float(ang_err), misses)
 
 
 def _solve_widening_step(solver, config: IKConfig, iteration: int) -> bool:
@@ -193,17 +214,30 @@ def _solve_widening_step(solver, config: IKConfig, iteration: int) -> bool:
             solver.dt *= 2
 
 
-def _errors(kin: HuboKinematics, support, moving, config: IKConfig) -> tuple[float, float, bool]:
-    """Worst position and angle errors, and whether every hold meets its tolerance."""
-    ok = True
-    pos_err = ang_err = 0.0
+def _each_hold_error(kin: HuboKinematics, support, moving, config: IKConfig):
+    """Per hold (supporting ones first): the hold, its position [m] and angle [rad] errors
+    and whether both are within its tolerance."""
     for holds, tol, atol in ((support, config.position_tol_m, config.angle_tol_rad),
                              (moving, config.moving_tol_m, config.moving_angle_tol_rad)):
         for h in holds:
             dp, da = _hold_error(kin, h.frame, h.T_world_frame, h.is_hand)
-            ok &= dp < tol and da < atol
-            pos_err, ang_err = max(pos_err, dp), max(ang_err, da)
+            yield h, dp, da, dp < tol and da < atol
+
+
+def _errors(kin: HuboKinematics, support, moving, config: IKConfig) -> tuple[float, float, bool]:
+    """Worst position and angle errors, and whether every hold meets its tolerance."""
+    ok = True
+    pos_err = ang_err = 0.0
+    for _, dp, da, met in _each_hold_error(kin, support, moving, config):
+        ok &= met
+        pos_err, ang_err = max(pos_err, dp), max(ang_err, da)
     return pos_err, ang_err, ok
+
+
+def _misses(kin: HuboKinematics, support, moving, config: IKConfig) -> tuple[HoldMiss, ...]:
+    """The holds not met within their tolerance, at the robot's current state."""
+    return tuple(HoldMiss(h.limb, h.target, dp, da)
+                 for h, dp, da, met in _each_hold_error(kin, support, moving, config) if not met)
 
 
 def _add_hold_task(solver, hold: Hold, priority: str, w_pos: float, w_ori: float,

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from planner.configuration.collision import CollisionModel
+from planner.configuration.ik import HoldMiss
 from planner.configuration.kinematics import HuboKinematics
 from planner.contacts import Stance
 from planner.statics.arm_capacity import (
@@ -43,6 +44,8 @@ class Verdict:
     environment_only: bool = False  # the only problem is a collision with the ladder/floor
     cause: RejectCause | None = None  # why it is not feasible (None when it is)
     colliding: tuple[tuple[str, str], ...] = ()  # the colliding pairs, for a collision
+    torque_joint: str = ""  # the joint of the worst torque ratio, for a torque rejection
+    ik_misses: tuple[HoldMiss, ...] = ()  # the holds an IK failure left unmet
 
     def __bool__(self) -> bool:
         return self.ok
@@ -126,7 +129,8 @@ class FeasibilityChecker:
             else:
                 cause = RejectCause.TORQUE
                 why = f"torque {ratio:.2f}× limit at {report.torque.worst_joint}"
-            return Verdict(False, why, report.margin_m, ratio, cause=cause)
+            return Verdict(False, why, report.margin_m, ratio, cause=cause,
+                           torque_joint=report.torque.worst_joint if report.torque else "")
         return Verdict(True, "ok", report.margin_m, ratio)
 
     def within_limits(self, q: np.ndarray) -> bool:

@@ -15,7 +15,7 @@ import pinocchio as pin
 
 from planner.configuration.ik import IKConfig, solve_ik
 from planner.configuration.kinematics import HuboKinematics
-from planner.configuration.validity import FeasibilityChecker
+from planner.configuration.validity import FeasibilityChecker, Verdict
 from planner.contacts import Hold, Stance
 from robot.errors import HuboLadderError
 from robot.vocabulary import InterpolationFailure, RejectCause
@@ -38,15 +38,18 @@ class InterpolationError(HuboLadderError):
         reason: the message, with the figures.
         depth: recursion depth of the failing midpoint.
         verdict_cause: for an infeasible midpoint, why the predicate refused it.
+        verdict: the refused midpoint's verdict (a failed projection's holds left unmet
+            as an IK verdict), for a failure message in user terms; None otherwise.
     """
 
     def __init__(self, cause: InterpolationFailure, reason: str, depth: int,
-                 verdict_cause: RejectCause | None = None):
+                 verdict_cause: RejectCause | None = None, verdict: Verdict | None = None):
         super().__init__(f"{reason} (recursion depth {depth})")
         self.cause = cause
         self.reason = reason
         self.depth = depth
         self.verdict_cause = verdict_cause
+        self.verdict = verdict
 
 
 @dataclass
@@ -97,7 +100,10 @@ def contact_space_interpolate(kin: HuboKinematics, checker: FeasibilityChecker,
         stats.projections += 1
         if not res.converged:
             raise InterpolationError(InterpolationFailure.PROJECTION_FAILED,
-                                     f"projection failed: {res!r}", depth)
+                                     f"projection failed: {res!r}", depth,
+                                     verdict=Verdict(False, f"ik {res!r}", np.nan, np.nan,
+                                                     cause=RejectCause.IK,
+                                                     ik_misses=res.misses))
         if max(kin.joint_distance(q0, res.q), kin.joint_distance(res.q, q1)) > JUMP_RATIO * span:
             worst = int(np.argmax(np.abs(res.q[7:] - qm[7:])))
             raise InterpolationError(
@@ -132,7 +138,7 @@ def contact_space_interpolate(kin: HuboKinematics, checker: FeasibilityChecker,
         if not verdict.ok:
             raise InterpolationError(InterpolationFailure.MIDPOINT_INFEASIBLE,
                                      f"midpoint infeasible: {verdict.reason}", depth,
-                                     verdict.cause)
+                                     verdict.cause, verdict)
         stats.min_margin_m = min(stats.min_margin_m, verdict.com_margin_m)
         stats.max_torque_ratio = max(stats.max_torque_ratio, verdict.torque_ratio)
         return rec(q0, q_mid, depth + 1) + rec(q_mid, q1, depth + 1)
