@@ -192,8 +192,10 @@ def solve_ik(kin: HuboKinematics, q_seed: np.ndarray, support: tuple[Hold, ...],
         pos_err, ang_err, ok = _errors(kin, support, moving, config)
         if ok and it > 2:
             break
-    converged = bool(np.isfinite(pos_err)) and _errors(kin, support, moving, config)[2]
-    misses = () if converged else _misses(kin, support, moving, config)
+    final = list(_each_hold_error(kin, support, moving, config))
+    converged = bool(np.isfinite(pos_err)) and all(met for *_, met in final)
+    misses = () if converged else tuple(HoldMiss(h.limb, h.target, dp, da)
+                                        for h, dp, da, met in final if not met)
     return IKResult(kin.q, converged, it, float(pos_err), float(ang_err), misses)
 
 
@@ -232,12 +234,6 @@ def _errors(kin: HuboKinematics, support, moving, config: IKConfig) -> tuple[flo
         ok &= met
         pos_err, ang_err = max(pos_err, dp), max(ang_err, da)
     return pos_err, ang_err, ok
-
-
-def _misses(kin: HuboKinematics, support, moving, config: IKConfig) -> tuple[HoldMiss, ...]:
-    """The holds not met within their tolerance, at the robot's current state."""
-    return tuple(HoldMiss(h.limb, h.target, dp, da)
-                 for h, dp, da, met in _each_hold_error(kin, support, moving, config) if not met)
 
 
 def _add_hold_task(solver, hold: Hold, priority: str, w_pos: float, w_ori: float,
