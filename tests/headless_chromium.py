@@ -11,6 +11,7 @@ import base64
 import contextlib
 import itertools
 import json
+import os
 import shutil
 import subprocess
 import time
@@ -39,7 +40,9 @@ class Chromium:
              "--hide-scrollbars", "--no-first-run", "--remote-debugging-port=0",
              "--remote-allow-origins=*", f"--user-data-dir={profile}",
              f"--window-size={size_px[0]},{size_px[1]}", "about:blank"],
-            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+            # its singleton socket folders go with the profile, not into /tmp for good
+            env={**os.environ, "TMPDIR": str(profile)})
         port_file = profile / "DevToolsActivePort"
         deadline = time.monotonic() + 60
         while not (port_file.exists() and port_file.read_text().strip()):
