@@ -11,11 +11,9 @@ One `RobotBridge` per daemon instance, on the robot's computer:
   joint limits, finite values, modes, feed-forward bounds; `daemon.loop`). The bridge
   never repeats a sample: when the link drops, the channel ages and the daemon's watchdog
   holds the robot, as for a player that died.
-- **commands in** (zenoh queries, each answered): board commands through
-  `daemon.console.Console` (the same refusals as ``hubo-console``: joints, gain
-  limits, and its wait until the daemon has ticked past), neck keys through
-  `daemon.neck.press` (``hubo-neck``'s goals, clamped at the neck's limits) and the
-  player's pause and stop (`daemon.player_control`).
+- **commands in** (zenoh queries, each answered): the board commands allowed over the
+  network, neck keys and the player's pause and stop, through `daemon.local_commands`
+  (the same code and refusals as ``hubo-console``, ``hubo-neck`` and the local page).
 
 Freshness. Every sample and command carries the ``time_ns`` of the newest state its
 sender had (`daemon.remote.keys`); one older than ``1 / rate_hz + max_delay_s`` on the
@@ -30,7 +28,6 @@ bridge counts and logs such peers when they connect (`BridgeStats.readonly_peers
 
 from __future__ import annotations
 
-import io
 import logging
 import queue
 import threading
@@ -39,7 +36,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from daemon.player_control import PlayerCommand, signal_player
+from daemon.player_control import PlayerCommand
 from daemon.remote.keys import COMMANDS, Topic, decode_stamp, key
 from daemon.remote.session_config import TlsFiles, check_endpoint, open_session, robot_config
 from daemon.structs import REF_DTYPE
@@ -138,14 +135,12 @@ class RobotBridge:
         import zenoh
 
         from daemon.channels import open_channel
-        from daemon.neck import NeckLink
-        from daemon.neck import default_config as neck_defaults
+        from daemon.local_commands import LocalCommands
 
         self.config = config
         self.stats = BridgeStats()
         self._age_limit_ns = round(config.max_age_s * 1e9)
-        self._neck = NeckLink(config.instance, config.robot)  # holds a Console
-        self._neck_config = neck_defaults()
+        self._local = LocalCommands(config.instance, config.robot)
         self._state = open_channel("state", config.instance)
         self._ref = open_channel("ref", config.instance)
         self._ref_lock = threading.Lock()
@@ -298,31 +293,21 @@ class RobotBridge:
                 or the tool's own refusal); nothing was sent.
             HuboLadderError: the daemon did not answer.
         """
-        from daemon.neck import press
-
         if topic == Topic.CONSOLE.value:
             words = text.split()
             if not words or words[0].lower() not in REMOTE_CONSOLE_COMMANDS:
                 raise InputError(f"console command {text!r} not allowed over the bridge; "
                                  "allowed: homeAll, home J, reset J, iniSensors, kp J v, "
                                  "kd J v, maxPWM J v")
-            out = io.StringIO()
-            self._neck.console.out = out
-            self._neck.console.execute(text)
-            return out.getvalue().strip() or f"done: {text}"
+            return self._local.console(text)
         if topic == Topic.NECK.value:
-            if len(text) != 1:
-                raise InputError(f"neck command {text!r}: send one key at a time")
-            out = io.StringIO()
-            press(self._neck, text, self._neck_config, out)
-            return out.getvalue().strip()
+            return self._local.neck(text)
         if topic == Topic.PLAYER.value:
             try:
                 command = PlayerCommand(text.strip().lower())
             except ValueError:
                 raise InputError(f"player command {text!r}: use pause or stop") from None
-            return f"{command.value}: sent to the player (pid "\
-                   f"{signal_player(self.config.instance, command)})"
+            return self._local.player(command)
         raise InputError(f"unknown command topic {topic!r}")
 
     # ------------------------------------------------------------------ peers
@@ -351,6 +336,6 @@ class RobotBridge:
         session = getattr(self, "session", None)
         if session is not None and not session.is_closed():
             session.close()
-        self._neck.close()
+        self._local.close()
         self._state.close()
         self._ref.close()

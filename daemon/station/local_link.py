@@ -1,5 +1,5 @@
 """The page on the daemon's own computer: state from the shared-memory channels, commands
-through the local tools' code.
+through the local tools' code (`daemon.local_commands`).
 
 - state: the ``state`` channel, and the reference mode of the newest ``ref`` sample
   written since the daemon started;
@@ -13,42 +13,26 @@ through the local tools' code.
 
 from __future__ import annotations
 
-import io
-
-from daemon.console import Console
-from daemon.neck import NeckConfig, NeckLink, default_config, press
-from daemon.player_control import PlayerCommand, signal_player
+from daemon.local_commands import LocalCommands
+from daemon.neck import NeckConfig
+from daemon.player_control import PlayerCommand
 from daemon.station.link import StateReading, StationLink
-from robot.errors import InputError
 
 __all__ = ["LocalLink"]
 
 #: The daemon writes the state every 5 ms: a sample older than this means it stopped [s].
 STALE_AFTER_S = 0.5
 
-_SIGNAL_DONE = {PlayerCommand.PAUSE: "pause toggled: SIGUSR1 to play-trajectory pid {pid}",
-                PlayerCommand.STOP: "stopped: SIGTERM to play-trajectory pid {pid}; the "
-                                    "robot holds the last reference"}
-
 
 class LocalLink(StationLink):
-    """Daemon ``instance`` on this computer (see the module docstring).
-
-    Args:
-        instance: the daemon's channel namespace.
-        robot: whose joint limits goto, comp and the neck keys respect.
-        neck: the neck steps [rad]; the thesis's when None.
-    """
+    """Daemon ``instance`` on this computer (see the module docstring); the arguments are
+    `daemon.local_commands.LocalCommands`'s."""
 
     def __init__(self, instance: str = "default", robot: str = "drc-hubo",
                  neck: NeckConfig | None = None):
         super().__init__(instance, f"hubo-daemon instance {instance!r}", STALE_AFTER_S,
                          "no hubo-daemon is ticking")
-        self.neck_config = neck or default_config()
-        self._out = io.StringIO()
-        self.console = Console(instance, out=self._out, robot=robot)
-        self._neck_link: NeckLink | None = None
-        self._robot = robot
+        self.commands = LocalCommands(instance, robot, neck)
         self._channels: dict = {}
 
     def _channel(self, name: str):
@@ -70,34 +54,18 @@ class LocalLink(StationLink):
         mode = r["mode"] if r is not None and int(r["time_ns"]) >= start_ns else None
         return StateReading(s, mode, int(s["time_ns"]))
 
-    def _printed(self, job) -> str:
-        """Run ``job`` with the tools' output captured; what they printed."""
-        self._out.seek(0)
-        self._out.truncate()
-        job()
-        return self._out.getvalue().strip()
-
     def _console(self, line: str) -> str:
-        def job() -> None:
-            if not self.console.execute(line):
-                raise InputError("quit is for the terminal; the page stays")
-
-        return self._printed(job)
+        return self.commands.console(line)
 
     def _neck(self, key: str) -> str:
-        if self._neck_link is None:
-            self._neck_link = NeckLink(self.instance, self._robot)
-        return self._printed(lambda: press(self._neck_link, key, self.neck_config,
-                                           out=self._out))
+        return self.commands.neck(key)
 
     def _player(self, command: PlayerCommand) -> str:
-        return _SIGNAL_DONE[command].format(pid=signal_player(self.instance, command))
+        return self.commands.player(command)
 
     def close(self) -> None:
         with self._lock:
-            self.console.close()
-            if self._neck_link is not None:
-                self._neck_link.close()
+            self.commands.close()
             for c in self._channels.values():
                 c.close()
             self._channels.clear()
