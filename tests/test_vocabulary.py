@@ -66,12 +66,14 @@ def test_every_project_error_derives_from_the_root():
 
 
 def test_planner_errors_carry_fields():
+    from planner.configuration.validity import Verdict
     from planner.paths.interpolation import InterpolationError
     from planner.time_limit import TimeLimitExceeded
     from robot.vocabulary import InterpolationFailure, RejectCause
 
+    refused = Verdict(False, "collision a–b", 0.01, 0.5, cause=RejectCause.COLLISION)
     exc = InterpolationError(InterpolationFailure.MIDPOINT_INFEASIBLE,
-                             "midpoint infeasible: collision a–b", 3, RejectCause.COLLISION)
+                             "midpoint infeasible: collision a–b", 3, refused)
     assert isinstance(exc, HuboLadderError) and exc.depth == 3
     assert exc.cause is InterpolationFailure.MIDPOINT_INFEASIBLE
     assert exc.verdict_cause is RejectCause.COLLISION

@@ -37,19 +37,22 @@ class InterpolationError(HuboLadderError):
         cause: what failed.
         reason: the message, with the figures.
         depth: recursion depth of the failing midpoint.
-        verdict_cause: for an infeasible midpoint, why the predicate refused it.
         verdict: the refused midpoint's verdict (a failed projection's holds left unmet
             as an IK verdict), for a failure message in user terms; None otherwise.
     """
 
     def __init__(self, cause: InterpolationFailure, reason: str, depth: int,
-                 verdict_cause: RejectCause | None = None, verdict: Verdict | None = None):
+                 verdict: Verdict | None = None):
         super().__init__(f"{reason} (recursion depth {depth})")
         self.cause = cause
         self.reason = reason
         self.depth = depth
-        self.verdict_cause = verdict_cause
         self.verdict = verdict
+
+    @property
+    def verdict_cause(self) -> RejectCause | None:
+        """Why the predicate refused the midpoint (its verdict's cause), if it did."""
+        return None if self.verdict is None else self.verdict.cause
 
 
 @dataclass
@@ -138,7 +141,7 @@ def contact_space_interpolate(kin: HuboKinematics, checker: FeasibilityChecker,
         if not verdict.ok:
             raise InterpolationError(InterpolationFailure.MIDPOINT_INFEASIBLE,
                                      f"midpoint infeasible: {verdict.reason}", depth,
-                                     verdict.cause, verdict)
+                                     verdict)
         stats.min_margin_m = min(stats.min_margin_m, verdict.com_margin_m)
         stats.max_torque_ratio = max(stats.max_torque_ratio, verdict.torque_ratio)
         return rec(q0, q_mid, depth + 1) + rec(q_mid, q1, depth + 1)
