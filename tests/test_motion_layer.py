@@ -201,6 +201,30 @@ def test_a_compliant_arm_short_of_its_hold_finishes_the_reach_stiff(reach):
     assert (mixed.log.pwm[-1, left] == compliant).all()
 
 
+def test_an_arm_that_leaves_its_rail_compliant_still_counts_as_stiff_in_the_air(reach):
+    """A mixed arm complies as it lets go of its rail and again on the last lines before
+    it closes; in between it moves in position mode. Such a reach may finish stiff (on
+    `ship` the right arm waited 4 s 1.7 cm short of its hold and closed on nothing)."""
+    from execute.motion.layer import MotionLayer, _Regrasp
+    from execute.play.player import PlayerOptions, TrajectoryPlayer
+
+    _path, traj, sc, ladder = reach
+    grasp = next(k for k, seg in enumerate(sc.segments) if seg.phase == "grasp")
+    reach_seg = sc.segments[grasp - 1]
+    n = len(traj)
+
+    def stiff_in_air(runs):
+        player = TrajectoryPlayer(traj, PlayerOptions(rate_hz=int(sc.rate_hz)),
+                                  {"left": runs, "right": runs})
+        layer = MotionLayer(player, traj, sc, ladder)
+        return layer._stiff_in_air(_Regrasp("left", grasp, "rail_left", np.zeros(3), "arrive", 0.0))
+
+    a, b = reach_seg.first_line, reach_seg.last_line
+    leaves_compliant = [(1, a + 4, "pwm"), (a + 5, b - 5, "position"), (b - 4, n, "pwm")]
+    assert stiff_in_air(leaves_compliant)
+    assert not stiff_in_air([(1, n, "pwm")])
+
+
 def test_an_unrecoverable_miss_holds_with_no_weight_shift(reach, tmp_path):
     """Rails 11.5 cm beyond the closing palms, out of the search's reach: the layer stops
     at the grasp, the player never moves on to the lines that load the hands, and the

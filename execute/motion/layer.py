@@ -325,12 +325,13 @@ class MotionLayer:
 
     def _stiff_in_air(self, g: _Regrasp) -> bool:
         """Whether the arm's schedule moved it in position mode through the air on its way
-        to this grasp (the first line of the reach that precedes it)."""
+        to this grasp (on any line of the reach that precedes it: a mixed arm still
+        complies as it leaves its rail, and again on the last lines before it closes)."""
         limb = f"{g.side}_hand"
         reach = next((seg for seg in reversed(self.sidecar.segments[:g.segment])
                       if seg.phase == "limb" and limb in seg.moving_limbs), None)
         return reach is not None and \
-            not self.player.schedule.pwm_by_line[g.side][reach.first_line - 1]
+            not self.player.schedule.pwm_by_line[g.side][reach.first_line - 1:reach.last_line].all()
 
     def _update_regrasp(self, s: SensedState) -> None:
         g, cfg, now = self._regrasp, self.config, self._now
