@@ -176,6 +176,18 @@ def test_a_misplaced_ladder_is_re_grasped_from_sensors(reach):
     assert "re-reach" in kinds or "reach correction" in kinds
     # the estimate found the ladder further away: across the rails, towards the ladder
     assert closed.motion["ladder_shift_m"][0] > 0.01
+    # a hand that closed on nothing is in the air: its mixed arm re-reaches stiff, in
+    # position mode from its first miss until its grasp is verified
+    events = closed.motion["events"]
+    missed = next(e for e in events if e["kind"] == "grasp missed")
+    assert any(e["kind"] == "stiff reach" and e["limb"] == missed["limb"]
+               and "closed on nothing" in e["cause"] for e in events)
+    verified = next(e for e in events if e["kind"] == "grasp verified"
+                    and e["limb"] == missed["limb"] and e["time_s"] > missed["time_s"])
+    arm = [JOINT_INDEX[j] for j in ARM_JOINTS[missed["limb"].split("_")[0]]]
+    log = closed.log
+    re_reach = (log.time_s > missed["time_s"] + 0.01) & (log.time_s < verified["time_s"] - 0.01)
+    assert re_reach.any() and not log.pwm[re_reach][:, arm].any()
 
 
 def test_a_compliant_arm_short_of_its_hold_finishes_the_reach_stiff(reach):

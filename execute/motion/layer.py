@@ -385,6 +385,14 @@ class MotionLayer:
                               f"{'es' if g.tries != 1 else ''} for {g.rail}: the weight was "
                               "not moved onto it")
                 return
+            if g.side not in self._stiff_arms and self._stiff_in_air(g):
+                # a hand that closed on nothing is in the air: a mixed arm re-reaches in
+                # position mode, as it moved through the air, until its grasp is verified
+                # (compliant, an open hand sagged 3–4 cm below each new target on ship)
+                self._stiff_arms.add(g.side)
+                self._event(MotionEventKind.STIFF_REACH, limb, 0.0,
+                            "closed on nothing: the arm re-reaches in position mode until "
+                            "the grasp is verified")
             g.tries += 1
             g.phase, g.since_s = "open", now
             self._open_fingers.add(g.side)
