@@ -108,6 +108,67 @@ def test_the_ladder_estimate_recovers_shift_and_yaw():
     assert est.yaw_rad == pytest.approx(yaw, abs=0.005)
 
 
+def test_observations_on_the_ladder_move_the_shift_not_the_yaw():
+    """Hands seen at different times on the ladder, with the body's heading drifting
+    between them, must not read as the ladder turning: the floor's yaw is kept."""
+    est = LadderEstimate(max_shift_m=0.1, max_yaw_rad=0.3)
+    up = np.array([0.5, 0.0, np.sqrt(3) / 2])
+    holds = {"rail_left": np.array([0.7, 0.675, 1.0]), "rail_right": np.array([0.7, -0.675, 1.0])}
+    for rail, p in holds.items():
+        est.add(RailObservation(rail, p, p, up))  # on the floor: where planned
+    for rail, dx in (("rail_left", -0.03), ("rail_right", -0.01)):
+        p = holds[rail]
+        est.add(RailObservation(rail, p, p + [dx, 0.0, 0.0], up), fits_yaw=False)
+    assert est.yaw_rad == pytest.approx(0.0, abs=1e-6)
+    across = np.eye(3) - np.outer(up, up)
+    assert np.allclose(across @ est.shift_m, across @ [-0.02, 0.0, 0.0], atol=1e-3)
+
+
+def test_a_missed_grasp_searches_where_the_holding_hands_found_the_rails(reach):
+    """Leg odometry cannot see a stance foot creep on its rung: the estimate moves with
+    it and the rails seem to move the other way. The hands still holding their verified
+    grasps measure that at each segment. The reaches keep the floor's estimate; a hand
+    that closed on nothing first tries where the rails now seem to be. A hand that let go
+    no longer counts."""
+    from execute.motion.estimator import BodyEstimate
+    from execute.motion.layer import MotionLayer, _Regrasp
+    from execute.play.player import PlayerOptions, TrajectoryPlayer
+
+    _path, traj, sc, ladder = reach
+    grasp = next(k for k, seg in enumerate(sc.segments) if seg.phase == "grasp")
+    hold_seg = sc.segments[grasp + 1]
+    released = dataclasses.replace(hold_seg, holds={
+        limb: h for limb, h in hold_seg.holds.items() if limb != "left_hand"})
+    sc = dataclasses.replace(sc, segments=sc.segments + (released,))
+    layer = MotionLayer(TrajectoryPlayer(traj, PlayerOptions(rate_hz=int(sc.rate_hz))),
+                        traj, sc, ladder)
+    planned = {side: np.asarray(hold_seg.holds[f"{side}_hand"].position_m)
+               for side in ("left", "right")}
+
+    def sense(offset_m):
+        layer.estimate = BodyEstimate(0.0, np.eye(4), np.eye(3), {"left": True, "right": True},
+                                      {s: planned[s] + offset_m for s in planned}, {},
+                                      {"left": 0.09, "right": 0.09})
+
+    layer.player.step(0.0, traj[0])
+    layer.player.pause(0.0)  # the player waits while a grasp is verified
+    sense(np.zeros(3))
+    for side in ("left", "right"):
+        layer._grasp_verified(_Regrasp(side, grasp, f"rail_{side}", planned[side], "verify", 0.0))
+    creep = np.array([-0.03, 0.0, 0.0])  # the feet crept 3 cm towards the ladder
+    sense(creep)
+    layer._enter_segment(grasp + 1)
+    rail_up = layer._rail_direction("rail_left")
+    across = np.eye(3) - np.outer(rail_up, rail_up)
+    assert np.allclose(across @ layer.rails.shift_m, across @ creep, atol=2e-3)
+    assert np.allclose(layer.ladder.shift_m, 0.0, atol=1e-3)  # the reaches' estimate
+    first = layer._candidates(_Regrasp("left", grasp, "rail_left", planned["left"], "verify", 0.0))
+    assert np.allclose(across @ first[0], across @ creep, atol=2e-3)
+    sense(np.zeros(3))  # the left hand let go: only the right one measures
+    layer._enter_segment(len(sc.segments) - 1)
+    assert set(layer._held_rails) == {"right"}
+
+
 @pytest.mark.parametrize("field,value", [("max_reach_correction_m", 0.2),
                                          ("grasp_retries", -1),
                                          ("max_reach_correction_rad", 1.0)])

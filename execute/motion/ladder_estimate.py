@@ -1,17 +1,23 @@
-"""Where the ladder really stands, from the grasps the fingers confirmed while the robot
-stood on the floor (`execute.motion.layer` adds only those: there leg odometry is exact).
+"""Where the ladder stands in the state estimate's frame, from the hands on its rails.
 
 A hand closed on a rail has the rail's axis in its grip centre, so each verified grasp
-measures, through the encoders and leg odometry, where that rail is. Against the plan's
-hold on it, the difference across the rail (its component along the rail says nothing)
-is a measurement of the ladder's misplacement. With one rail seen the shift is all we
-estimate; with both, the yaw too. The model, linear in the unknowns:
+measures, through the encoders and leg odometry, where that rail is; `execute.motion.layer`
+measures a holding hand again at every segment. Against the plan's hold on it, the
+difference across the rail (its component along the rail says nothing) measures the
+ladder's misplacement. The model, linear in the unknowns:
 
     p_real = p_plan + δ + ψ · ẑ × (p_plan − c)
 
 δ the ladder's shift [m], ψ its yaw [rad] about the vertical through ``c`` (the middle
-of the observed holds). Each observation constrains the two directions across its
-rail; a small ridge keeps unobserved directions at zero.
+of the holds observed on the floor). Each observation constrains the two directions
+across its rail; a small ridge keeps unobserved directions at zero.
+
+On the floor leg odometry is exact: those observations fit δ, and ψ once both rails are
+seen. On the ladder the estimate also carries the stance feet's creep on their rungs,
+which odometry cannot see (on `ship`, 2026-11-27: 2–3 cm forward and 1–2° of heading over
+500 s): the rails seem to move by as much the other way. Those observations move δ
+alone, at the floor's ψ: hands seen at different times, and held one rung apart, cannot
+tell the body's heading from their own lateral settling.
 """
 
 from __future__ import annotations
@@ -52,6 +58,7 @@ class LadderEstimate:
     def __init__(self, max_shift_m: float, max_yaw_rad: float):
         self.max_shift_m, self.max_yaw_rad = max_shift_m, max_yaw_rad
         self._latest: dict[str, RailObservation] = {}
+        self._for_yaw: dict[str, RailObservation] = {}
         self.shift_m = np.zeros(3)
         self.yaw_rad = 0.0
         self.centre_m = np.zeros(3)
@@ -60,26 +67,45 @@ class LadderEstimate:
     def observed(self) -> bool:
         return bool(self._latest)
 
-    def add(self, obs: RailObservation) -> None:
-        """Fold in a verified grasp (the newest one per rail counts)."""
+    def add(self, obs: RailObservation, *, fits_yaw: bool = True) -> None:
+        """Fold in a hand on its rail. The newest observation per rail counts: the frame
+        drifts as the feet creep.
+
+        Args:
+            fits_yaw: the observation fits the yaw too: it was taken on the floor,
+                where leg odometry is exact. Others move the shift alone, at the floor's
+                yaw (module docstring).
+        """
         self._latest[obs.rail] = obs
-        observations = list(self._latest.values())
-        self.centre_m = np.mean([o.planned_m for o in observations], axis=0)
-        rows, rhs = [], []
-        for o in observations:
-            P = np.eye(3) - np.outer(o.rail_direction, o.rail_direction)
-            A = np.hstack([P, (P @ _skew_z_times(o.planned_m - self.centre_m))[:, None]])
-            rows.append(A)
-            rhs.append(P @ (o.measured_m - o.planned_m))
-        rows.append(np.sqrt(_RIDGE) * np.eye(4))
-        rhs.append(np.zeros(4))
-        x = np.linalg.lstsq(np.vstack(rows), np.concatenate(rhs), rcond=None)[0]
-        shift, yaw = x[:3], float(x[3])
+        if fits_yaw:
+            self._for_yaw[obs.rail] = obs
+            seen = list(self._for_yaw.values())
+            self.centre_m = np.mean([o.planned_m for o in seen], axis=0)
+            yaw = float(self._fit(seen, None)[3])
+            self.yaw_rad = float(np.clip(yaw, -self.max_yaw_rad, self.max_yaw_rad))
+        shift = self._fit(list(self._latest.values()), self.yaw_rad)
         length = float(np.linalg.norm(shift))
         if length > self.max_shift_m:
             shift = shift * (self.max_shift_m / length)
         self.shift_m = shift
-        self.yaw_rad = float(np.clip(yaw, -self.max_yaw_rad, self.max_yaw_rad))
+
+    def _fit(self, observations: list[RailObservation], yaw_rad: float | None) -> np.ndarray:
+        """Least squares across the rails: (shift, yaw), or the shift at ``yaw_rad``."""
+        rows, rhs = [], []
+        for o in observations:
+            P = np.eye(3) - np.outer(o.rail_direction, o.rail_direction)
+            turn = P @ _skew_z_times(o.planned_m - self.centre_m)
+            residual = P @ (o.measured_m - o.planned_m)
+            if yaw_rad is None:
+                rows.append(np.hstack([P, turn[:, None]]))
+            else:
+                rows.append(P)
+                residual = residual - yaw_rad * turn
+            rhs.append(residual)
+        n = 4 if yaw_rad is None else 3
+        rows.append(np.sqrt(_RIDGE) * np.eye(n))
+        rhs.append(np.zeros(n))
+        return np.linalg.lstsq(np.vstack(rows), np.concatenate(rhs), rcond=None)[0]
 
     def correction_m(self, planned_m: np.ndarray) -> np.ndarray:
         """How far a hold planned at ``planned_m`` on the ladder really is [m]."""

@@ -143,6 +143,11 @@ class MotionLayer:
         self._last_now: float | None = None
         self.ladder = LadderEstimate(self.config.max_reach_correction_m,
                                      self.config.max_reach_correction_rad)
+        #: The rails in the estimate's frame as the hands last found them: every verified
+        #: grasp, and every hand still holding one at the start of a segment. A re-reach
+        #: searches around it (see `_candidates`).
+        self.rails = LadderEstimate(self.config.max_reach_correction_m,
+                                    self.config.max_reach_correction_rad)
         self._segment_of_line = segment_of_lines(sidecar, "plan")
         self._next_hold = self._next_holds(sidecar.segments)
         self._finger_cols = {side: joint_indices(FINGER_JOINTS[side]) for side in SIDES}
@@ -151,6 +156,8 @@ class MotionLayer:
         self._shift_m: dict[str, np.ndarray] = {}  # limb → world shift its offset makes [m]
         self._segment = -1
         self._verified_segments: set[tuple[int, str]] = set()
+        #: side → (rail, planned hold [m]) of a verified grasp the hand still holds
+        self._held_rails: dict[str, tuple[str, np.ndarray]] = {}
         self._arrived: set[tuple[int, str]] = set()
         self._last_ref = np.asarray(trajectory_rad[0], dtype=float).copy()
         self._regrasp: _Regrasp | None = None
@@ -160,6 +167,7 @@ class MotionLayer:
         self.stop: MotionStop | None = None
         self.estimate: BodyEstimate | None = None
         self._line = 0
+        self._now = 0.0
 
     # ------------------------------------------------------------------ plan queries
     @staticmethod
@@ -178,6 +186,11 @@ class MotionLayer:
 
     def _on_ladder(self, target: str) -> bool:
         return target != "floor"
+
+    @staticmethod
+    def _feet_on_floor(seg: Segment) -> bool:
+        """Both feet stand on the floor: leg odometry is exact."""
+        return all(h.target == "floor" for limb, h in seg.holds.items() if limb.endswith("_foot"))
 
     def _rail_direction(self, rail: str) -> np.ndarray:
         p0, p1 = self.geometry.rail_axis(rail.removeprefix("rail_"))
@@ -220,9 +233,34 @@ class MotionLayer:
         cap = self.config.max_reach_correction_m
         return shift_m if length <= cap else shift_m * (cap / length)
 
+    def _observe_held_rails(self, seg: Segment) -> None:
+        """Measure the rails again with every hand still holding its verified grasp.
+
+        Leg odometry anchors a stance foot where it landed; a sole that creeps on its
+        rung carries the whole estimate with it, and the rails seem to move the other
+        way (2–3 cm within 200 s on `ship`, 2026-11-27). The reaches keep the floor's
+        estimate, so that the body keeps its planned posture relative to its holds
+        (docs/decisions/rails-measured-again.md); only a hand that closed on nothing
+        searches where the rails now seem to be. A hand that let go of its hold is
+        forgotten until its next grasp is verified."""
+        on_floor = self._feet_on_floor(seg)
+        for side in SIDES:
+            if side not in self._held_rails:
+                continue
+            rail, planned_m = self._held_rails[side]
+            hold = seg.holds.get(f"{side}_hand")
+            if hold is None or hold.target != rail \
+                    or np.linalg.norm(np.asarray(hold.position_m) - planned_m) > SAME_TARGET_M:
+                del self._held_rails[side]
+                continue
+            self.rails.add(RailObservation(rail, planned_m, self.estimate.palm_m[side],
+                                           self._rail_direction(rail)), fits_yaw=on_floor)
+
     def _enter_segment(self, k: int) -> None:
-        """Re-target the reaches of segment ``k`` from the ladder estimate."""
+        """Measure the held rails again; re-target the reaches of segment ``k`` from the
+        ladder estimate."""
         seg = self.sidecar.segments[k]
+        self._observe_held_rails(seg)
         for limb, (_j, hold) in self._next_hold[k].items():
             if seg.phase != "limb" or not self._on_ladder(hold.target):
                 continue
@@ -286,26 +324,26 @@ class MotionLayer:
         return float(np.linalg.norm(got - want))
 
     def _candidates(self, g: _Regrasp) -> list[np.ndarray]:
-        """Re-reach shifts [m]: first the miss as the estimate measured it, taken back
-        across the rail (where the palm closed against where it was sent); then the
-        ladder estimate's target and a pattern around it. Each within the bound and
-        different from where the hand closed last."""
-        centre = self._ladder_shift(g.planned_m)
+        """Re-reach shifts [m]: first where the hands last found the rails
+        (`_observe_held_rails`), then the miss as the estimate measured it, taken back
+        across the rail (where the palm closed against where it was sent), then a pattern
+        around the first. Each within the bound and different from where the hand closed
+        last and from the others."""
+        rails = self._bounded(self.rails.correction_m(g.planned_m)) if self.rails.observed \
+            else np.zeros(3)
+        centre = rails if np.linalg.norm(rails) >= MIN_CORRECTION_M else np.zeros(3)
         towards_ladder = -self.geometry.rung_line_normal
         step = self.config.search_step_m
         current = self._shift_m.get(f"{g.side}_hand", np.zeros(3))
         axis = self._rail_direction(g.rail)
         miss = self.estimate.palm_m[g.side] - (g.planned_m + current)
         miss -= (miss @ axis) * axis
+        pattern = [self._bounded(centre + step * (across * towards_ladder
+                                                  + lateral * self.geometry.lateral_direction))
+                   for across, lateral in SEARCH_PATTERN]
         out: list[np.ndarray] = []
-        measured = self._bounded(current - miss)
-        if np.linalg.norm(measured - current) > SAME_TARGET_M:
-            out.append(measured)
-        for across, lateral in ((0, 0),) + SEARCH_PATTERN:
-            shift = self._bounded(centre + step * (across * towards_ladder
-                                                   + lateral * self.geometry.lateral_direction))
-            tried = [current] + out
-            if all(np.linalg.norm(shift - t) > SAME_TARGET_M for t in tried):
+        for shift in [centre, self._bounded(current - miss)] + pattern:
+            if all(np.linalg.norm(shift - t) > SAME_TARGET_M for t in [current] + out):
                 out.append(shift)
         return out
 
@@ -424,12 +462,14 @@ class MotionLayer:
                     f"palm {np.round(off * 100, 1).tolist()} cm from the planned hold"
                     + (f" after {g.tries} re-reach{'es' if g.tries != 1 else ''}"
                        if g.tries else ""))
-        seg = self.sidecar.segments[g.segment]
-        if all(h.target == "floor" for limb, h in seg.holds.items() if limb.endswith("_foot")):
+        observed = RailObservation(g.rail, g.planned_m, palm, self._rail_direction(g.rail))
+        on_floor = self._feet_on_floor(self.sidecar.segments[g.segment])
+        self.rails.add(observed, fits_yaw=on_floor)
+        self._held_rails[g.side] = (g.rail, g.planned_m)
+        if on_floor:
             # standing on the floor, leg odometry is exact; on the ladder it carries the
             # feet's creep, which would read as the ladder moving
-            self.ladder.add(RailObservation(g.rail, g.planned_m, palm,
-                                            self._rail_direction(g.rail)))
+            self.ladder.add(observed)
             self._event(MotionEventKind.LADDER_ESTIMATE, "",
                         float(np.linalg.norm(self.ladder.shift_m)),
                         f"ladder shifted {np.round(self.ladder.shift_m * 100, 1).tolist()} "
