@@ -24,6 +24,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from robot.words import limb_words, target_words
+
 if TYPE_CHECKING:
     from planner.search import ClimbPlanner, SearchResult
 
@@ -38,12 +40,7 @@ _LIMB_MARK = {"left_foot": ("s", "tab:olive"), "right_foot": ("s", "tab:purple")
 def hold_in_words(limb: str, target: str) -> str:
     """``left_foot``, ``rung_3`` → "left foot on rung 3"; ``rail_right`` → "on the right
     rail"."""
-    where = target.replace("_", " ")
-    if target.startswith("rail_"):
-        where = f"the {target[5:]} rail"
-    elif target == "floor":
-        where = "the floor"
-    return f"{limb.replace('_', ' ')} on {where}"
+    return f"{limb_words(limb)} on {target_words(target)}"
 
 
 def step_in_words(primitive: str, phase: str, rung: int) -> str:

@@ -640,8 +640,7 @@ class ClimbPlanner:
         if not polished.converged:
             raise _StepRejected(StepFailure.HOLDS_NOT_MET,
                                 f"placed pose does not meet its holds: {polished!r}", "placing",
-                                Verdict(False, f"ik {polished!r}", np.nan, np.nan,
-                                        cause=RejectCause.IK, ik_misses=polished.misses))
+                                Verdict.ik_failure(polished))
         correction = self.kin.joint_distance(polished.q, q)
         if correction > POLISH_MAX_RAD:
             raise _StepRejected(StepFailure.POLISH_TOO_FAR,

@@ -220,12 +220,15 @@ class MotionLayer:
                                           R_world_pelvis.T @ shift_world_m,
                                           R_world_pelvis.T @ turn_world @ R_world_pelvis)
 
-    def _ladder_shift(self, planned_m: np.ndarray) -> np.ndarray:
-        """Where the ladder estimate puts a hold planned at ``planned_m``, as a shift [m]:
-        zero without an estimate or below `MIN_CORRECTION_M`, bounded above."""
-        if not self.ladder.observed:
+    def _ladder_shift(self, planned_m: np.ndarray,
+                      estimate: LadderEstimate | None = None) -> np.ndarray:
+        """Where ``estimate`` (the ladder estimate unless given) puts a hold planned at
+        ``planned_m``, as a shift [m]: zero without an estimate or below
+        `MIN_CORRECTION_M`, bounded above."""
+        estimate = self.ladder if estimate is None else estimate
+        if not estimate.observed:
             return np.zeros(3)
-        shift = self._bounded(self.ladder.correction_m(planned_m))
+        shift = self._bounded(estimate.correction_m(planned_m))
         return shift if float(np.linalg.norm(shift)) >= MIN_CORRECTION_M else np.zeros(3)
 
     def _bounded(self, shift_m: np.ndarray) -> np.ndarray:
@@ -329,9 +332,7 @@ class MotionLayer:
         across the rail (where the palm closed against where it was sent), then a pattern
         around the first. Each within the bound and different from where the hand closed
         last and from the others."""
-        rails = self._bounded(self.rails.correction_m(g.planned_m)) if self.rails.observed \
-            else np.zeros(3)
-        centre = rails if np.linalg.norm(rails) >= MIN_CORRECTION_M else np.zeros(3)
+        centre = self._ladder_shift(g.planned_m, self.rails)
         towards_ladder = -self.geometry.rung_line_normal
         step = self.config.search_step_m
         current = self._shift_m.get(f"{g.side}_hand", np.zeros(3))

@@ -187,8 +187,7 @@ def find_feasible(kin: HuboKinematics, checker: FeasibilityChecker, q_seed: np.n
                               config=ik_config)
             if not result.converged:
                 stats.ik_failures += 1
-                last = Verdict(False, f"ik {result!r}", np.nan, np.nan, cause=RejectCause.IK,
-                               ik_misses=result.misses)
+                last = Verdict.ik_failure(result)
                 break
             verdict = checker.check(result.q, target.stability_stance, target.contacts)
             if verdict.ok:

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from planner.configuration.collision import CollisionModel
-from planner.configuration.ik import HoldMiss
+from planner.configuration.ik import HoldMiss, IKResult
 from planner.configuration.kinematics import HuboKinematics
 from planner.contacts import Stance
 from planner.statics.arm_capacity import (
@@ -49,6 +49,12 @@ class Verdict:
 
     def __bool__(self) -> bool:
         return self.ok
+
+    @classmethod
+    def ik_failure(cls, result: IKResult) -> Verdict:
+        """The verdict on an IK solve that did not converge: the holds it left unmet."""
+        return cls(False, f"ik {result!r}", np.nan, np.nan, cause=RejectCause.IK,
+                   ik_misses=result.misses)
 
 
 class FeasibilityChecker:

@@ -104,9 +104,7 @@ def contact_space_interpolate(kin: HuboKinematics, checker: FeasibilityChecker,
         if not res.converged:
             raise InterpolationError(InterpolationFailure.PROJECTION_FAILED,
                                      f"projection failed: {res!r}", depth,
-                                     verdict=Verdict(False, f"ik {res!r}", np.nan, np.nan,
-                                                     cause=RejectCause.IK,
-                                                     ik_misses=res.misses))
+                                     verdict=Verdict.ik_failure(res))
         if max(kin.joint_distance(q0, res.q), kin.joint_distance(res.q, q1)) > JUMP_RATIO * span:
             worst = int(np.argmax(np.abs(res.q[7:] - qm[7:])))
             raise InterpolationError(
