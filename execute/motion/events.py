@@ -15,6 +15,7 @@ class MotionEventKind(enum.Enum):
     RE_REACH = "re-reach"  #: a missed hand opens, moves and closes again
     ARRIVAL_WAIT = "arrival wait"  #: a hand lagged its reference; the grasp waited for it
     STIFF_REACH = "stiff reach"  #: a compliant arm short of its hold finished in position mode
+    LEG_RELIEF = "leg relief"  #: the gripping arms began to lift more: a leg joint neared its limit
     LADDER_ESTIMATE = "ladder estimate"  #: the estimate of the ladder's pose changed
     STOP = "stop"  #: the layer holds the pose and stops the climb
 

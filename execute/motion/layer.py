@@ -22,6 +22,8 @@ hubo-motion-rt and the thesis's operator did (thesis §4.3.4, §6.2):
   climb ends with the reason. The weight never moves onto an unverified grasp;
 - **wrist-roll relief** of a gripping compliant arm (`execute.motion.wrist_relief`), from
   its motor current;
+- **leg relief** (`execute.motion.leg_relief`): while a stance leg's joint pushes near its
+  torque limit (motor current), the gripping compliant arms lift more of the body;
 - **reach correction**: every verified grasp measures where its rail is
   (`execute.motion.ladder_estimate`); every later reach of a hand or a foot to a hold on
   the ladder is re-targeted by that estimate, by inverse kinematics on the limb's chain
@@ -52,13 +54,14 @@ from execute.motion.gains import motion_pwm_gains
 from execute.motion.grasp_check import GraspReading, read_grasp
 from execute.motion.gravity_compensation import ArmGravityCompensation
 from execute.motion.ladder_estimate import LadderEstimate, RailObservation
+from execute.motion.leg_relief import LegRelief
 from execute.motion.robot_model import MotionRobotModel
 from execute.motion.sensed_state import SensedState
 from execute.motion.wrist_relief import WRIST_ROLL, WristRelief
 from execute.play.player import PlayerTick, TrajectoryPlayer, min_jerk
 from ladders.geometry import LadderGeometry
 from ladders.spec import LadderSpec
-from robot.joints import ARM_JOINTS, FINGER_JOINTS, joint_indices
+from robot.joints import ARM_JOINTS, FINGER_JOINTS, JOINT_NAMES, joint_indices
 from robot.plan_sidecar import PlanSidecar, Segment, segment_of_lines
 
 __all__ = ["MotionLayer"]
@@ -138,6 +141,7 @@ class MotionLayer:
         self.estimator = StateEstimator(self.model, soles, self.config.estimator)
         self.gravity = ArmGravityCompensation(self.model)
         self.wrist_relief = WristRelief(robot)
+        self.leg_relief = LegRelief(self.model, robot)
         #: The gains the daemon should run the compliant arms with (`execute.motion.gains`).
         self.pwm_gains = motion_pwm_gains()
         self._last_now: float | None = None
@@ -519,11 +523,14 @@ class MotionLayer:
         seg = self.sidecar.segments[int(self._segment_of_line[tick.line_index])]
         dt = 0.0 if self._last_now is None else self._now - self._last_now
         self._last_now = self._now
+        lifting: list[str] = []  # compliant arms gripping a rail
         for side in SIDES:
             hold = seg.holds.get(f"{side}_hand")
             cols = self._arm_cols[side]
             gripping = (hold is not None and hold.target.startswith("rail")
                         and bool(tick.comply[cols].all()))
+            if gripping and side not in self._stiff_arms:
+                lifting.append(side)
             wrist_roll = WRIST_ROLL[side]
             ref[wrist_roll] += self.wrist_relief.update(wrist_roll, gripping, s.cur_a, dt)
             share = self.config.holding_arm_stiffness
@@ -541,10 +548,28 @@ class MotionLayer:
         ff = tick.feedforward_nm
         if self.config.gravity_compensation and comply.any():  # else ff goes unused
             ff = self.gravity.feedforward_nm(ff, plan_rad, s.pos_rad, self.estimate.R_tilt)
+        ff = self._relieve_legs(seg, lifting, s, ff, dt)
         if ff is not tick.feedforward_nm or comply is not tick.comply:
             ff = np.where(comply, ff, 0.0)  # feed-forward acts only on compliant joints
         return dataclasses.replace(tick, ref_rad=ref, mode=mode, comply=comply,
                                    feedforward_nm=ff)
+
+    def _relieve_legs(self, seg: Segment, lifting: list[str], s: SensedState,
+                      ff: np.ndarray, dt: float) -> np.ndarray:
+        """``ff`` plus the leg relief's lift on the ``lifting`` arms (`LegRelief`)."""
+        stance = [side for side in SIDES if f"{side}_foot" in seg.holds
+                  and self.estimate.standing.get(side, False)]
+        before = self.leg_relief.lift_n
+        lift = self.leg_relief.update(stance, bool(lifting), s.cur_a, dt)
+        if before == 0.0 and lift > 0.0:
+            share, col = self.leg_relief.leg_load(stance, s.cur_a)
+            self._event(MotionEventKind.LEG_RELIEF, "", 0.0,
+                        f"{JOINT_NAMES[col]} at {share:.0%} of its torque limit: the "
+                        f"{' and '.join(lifting)} arm{'s' if len(lifting) > 1 else ''} "
+                        "lift more")
+        if lift == 0.0:
+            return ff
+        return ff + self.leg_relief.feedforward_nm(lifting, s.pos_rad, self.estimate.R_tilt)
 
     # ------------------------------------------------------------------ report
     def report(self) -> dict:
@@ -560,6 +585,8 @@ class MotionLayer:
                        "grasp_retries": self.config.grasp_retries},
             "counts": counts,
             "ladder_shift_m": [round(float(v), 4) for v in self.ladder.shift_m],
+            "leg_relief_peak_n": round(self.leg_relief.peak_lift_n, 1),
+            "leg_relief_joint": self.leg_relief.peak_joint,
             "ladder_yaw_rad": round(self.ladder.yaw_rad, 4),
             "stop": None if self.stop is None else dataclasses.asdict(self.stop),
             "events": [ev.to_json() for ev in self.events],

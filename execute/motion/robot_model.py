@@ -93,6 +93,22 @@ class MotionRobotModel:
         out[self._have] = g[self._v_cols]
         return out
 
+    def force_torques(self, q_cols_rad: np.ndarray, R_world_pelvis: np.ndarray, limb: str,
+                      force_world_n: np.ndarray) -> np.ndarray:
+        """``Jᵀ f`` by column [N·m]: the generalized force of a force ``force_world_n``
+        (world frame) applied at ``limb``'s end frame (its palm or sole), the pelvis
+        tilted by ``R_world_pelvis``."""
+        T = np.eye(4)
+        T[:3, :3] = R_world_pelvis
+        q = self.configuration(q_cols_rad, T)
+        fid = self._frame_id[self.chains[limb].frame]
+        J = pin.computeFrameJacobian(self.model, self.data, q, fid,
+                                     pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+        jt = J[:3].T @ np.asarray(force_world_n, dtype=float)
+        out = np.zeros(len(JOINT_NAMES))
+        out[self._have] = jt[self._v_cols]
+        return out
+
     def com_m(self, q_cols_rad: np.ndarray, T_world_pelvis: np.ndarray) -> np.ndarray:
         """Whole-body centre of mass in the world [m]."""
         return np.array(pin.centerOfMass(self.model, self.data,

@@ -1,0 +1,94 @@
+"""Leg relief: the gripping compliant arms lift more of the body while a stance leg's
+joint pushes near its torque limit.
+
+The plan shares the body's weight between the feet and the hands (the torque LP), and the
+compliant arms give their share through their feed-forward. On the robot they give it
+only roughly: their PWM stiffness towards the reference, the rigid wrist roll and the
+grip's slip about its rail change the wrench the hand delivers, and a position-controlled
+leg takes whatever the arms do not. On a one-foot stance the knee then climbs past its
+limit and its board trips (a stair mount: planned 48 N·m, 60 N·m in MuJoCo).
+
+The motor current says how hard each leg joint pushes (``τ = η·gear·Kt·I``,
+`robot.motors`). While the largest share of its limit over the stance legs' joints is
+above ``onset_fraction``, the hands' extra lift grows at ``rate_n_per_s``; below
+``release_fraction`` it shrinks at that rate; it is bounded by ``max_lift_n``. The lift is
+a vertical force of the rail on each gripping compliant hand, split evenly, sent as
+feed-forward torques ``−Jᵀ f`` on the arm's compliant joints at the sensed configuration
+and the IMU's tilt; each arm's PWM clamp (the daemon's) bounds what it can add.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from execute.motion.robot_model import MotionRobotModel
+from robot.joints import JOINT_NAMES, LEG_JOINTS, joint_indices
+from robot.limits import joint_limits
+from robot.motors import MotorTable, motor_table
+
+__all__ = ["LegRelief"]
+
+
+class LegRelief:
+    """The hands' extra lift from the stance legs' sensed torques (module docstring).
+
+    Args:
+        model: the motion layer's robot model.
+        robot: robot name (torque limits).
+        onset_fraction: share of a leg joint's limit above which the lift grows.
+        release_fraction: share below which it shrinks (hysteresis).
+        rate_n_per_s: how fast it grows or shrinks [N/s].
+        max_lift_n: the largest extra lift of all hands together [N].
+    """
+
+    def __init__(self, model: MotionRobotModel, robot: str = "drc-hubo",
+                 onset_fraction: float = 0.85, release_fraction: float = 0.75,
+                 rate_n_per_s: float = 40.0, max_lift_n: float = 80.0,
+                 motors: MotorTable | None = None):
+        self.model = model
+        self.limit_nm = joint_limits(robot).torque_max_nm
+        motors = motors or motor_table()
+        self._nm_per_a = motors.efficiency * motors.gear * motors.kt_nm_per_a
+        self._leg_cols = {side: np.array(joint_indices(LEG_JOINTS[side]))
+                          for side in LEG_JOINTS}
+        self.onset, self.release = onset_fraction, release_fraction
+        self.rate_n_per_s, self.max_lift_n = rate_n_per_s, max_lift_n
+        self.lift_n = 0.0
+        #: The largest lift of the run [N] and the leg joint that called for it.
+        self.peak_lift_n = 0.0
+        self.peak_joint = ""
+
+    def leg_load(self, stance_sides: list[str], cur_a: np.ndarray) -> tuple[float, int]:
+        """The largest |τ|/limit over the stance legs' joints, and its column (-1: none)."""
+        if not stance_sides:
+            return 0.0, -1
+        cols = np.concatenate([self._leg_cols[s] for s in stance_sides])
+        share = np.abs(cur_a[cols] * self._nm_per_a[cols]) / self.limit_nm[cols]
+        k = int(np.argmax(share))
+        return float(share[k]), int(cols[k])
+
+    def update(self, stance_sides: list[str], can_lift: bool, cur_a: np.ndarray,
+               dt_s: float) -> float:
+        """The lift after one tick [N]. ``can_lift``: a compliant hand grips a rail."""
+        share, col = self.leg_load(stance_sides, cur_a)
+        if can_lift and share > self.onset:
+            self.lift_n = min(self.max_lift_n, self.lift_n + self.rate_n_per_s * dt_s)
+            if self.lift_n > self.peak_lift_n:
+                self.peak_lift_n, self.peak_joint = self.lift_n, JOINT_NAMES[col]
+        elif share < self.release or not can_lift:
+            self.lift_n = max(0.0, self.lift_n - self.rate_n_per_s * dt_s)
+        return self.lift_n
+
+    def feedforward_nm(self, sides: list[str], q_sensed_rad: np.ndarray,
+                       R_tilt: np.ndarray) -> np.ndarray:
+        """Feed-forward torques by column [N·m] that make the rail push each hand of
+        ``sides`` up by its share of the lift (zero off their arms)."""
+        out = np.zeros(len(q_sensed_rad))
+        if self.lift_n <= 0.0 or not sides:
+            return out
+        per_hand = np.array([0.0, 0.0, self.lift_n / len(sides)])
+        for side in sides:
+            torque = self.model.force_torques(q_sensed_rad, R_tilt, f"{side}_hand", per_hand)
+            cols = list(self.model.chains[f"{side}_hand"].columns)
+            out[cols] = -torque[cols]
+        return out
