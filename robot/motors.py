@@ -135,6 +135,11 @@ class MotorTable:
         """Motor current that produces a joint torque [A] (signed like the torque)."""
         return torque_nm / (self.efficiency * self.gear * self.kt_nm_per_a)
 
+    def torque_nm(self, current_a: np.ndarray) -> np.ndarray:
+        """Joint torque a motor current produces [N·m] (`current_a`'s inverse): how hard a
+        joint pushes, from the current its board senses."""
+        return current_a * (self.efficiency * self.gear * self.kt_nm_per_a)
+
 
 def motor_table() -> MotorTable:
     """The motor constants of every column (see the module docstring's table)."""

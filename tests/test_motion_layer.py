@@ -354,3 +354,37 @@ def test_the_layers_arm_gains_are_inside_the_safety_limits():
 
     with pytest.raises(PwmGainError):
         motion_pwm_gains(8.5)
+
+
+def test_a_stiff_arm_that_pushes_on_something_complies_again(reach):
+    """A stiff arm whose shoulder current says it pushes at 90 % of its limit complies
+    again after 0.2 s; a shorter push (the stiff reach's own start) leaves it stiff."""
+    from execute.motion.layer import STIFF_ARM_YIELD_S, MotionLayer
+    from execute.motion.sensed_state import SensedState
+    from execute.play.player import PlayerOptions, TrajectoryPlayer
+    from robot.limits import joint_limits
+    from robot.motors import motor_table
+
+    _path, traj, sc, ladder = reach
+    layer = MotionLayer(TrajectoryPlayer(traj, PlayerOptions(rate_hz=int(sc.rate_hz))),
+                        traj, sc, ladder)
+    lsp = JOINT_INDEX["LSP"]
+    pushing = np.zeros(NUM_JOINTS)
+    pushing[lsp] = motor_table().current_a(0.9 * joint_limits().torque_max_nm)[lsp]
+    sample = new_sample(STATE_DTYPE)
+    sample["pos"] = traj[0]
+
+    def sensed(cur_a):
+        sample["cur"] = cur_a
+        return SensedState.from_sample(sample)
+
+    layer._stiff_arms.add("left")
+    for _ in range(int(0.1 / 0.005)):
+        layer._guard_stiff_arms(sensed(pushing), 0.005)
+    layer._guard_stiff_arms(sensed(np.zeros(NUM_JOINTS)), 0.005)
+    assert "left" in layer._stiff_arms  # a short push: still stiff
+    for _ in range(int(STIFF_ARM_YIELD_S / 0.005) + 1):
+        layer._guard_stiff_arms(sensed(pushing), 0.005)
+    assert "left" not in layer._stiff_arms
+    event = layer.events[-1]
+    assert event.kind.value == "stiff reach" and "LSP" in event.cause

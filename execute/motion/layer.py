@@ -20,6 +20,7 @@ hubo-motion-rt and the thesis's operator did (thesis §4.3.4, §6.2):
   closes again, up to ``grasp_retries`` times. If it still holds nothing
   the layer **stops**: the player stays paused, every verified grip is kept, and the
   climb ends with the reason. The weight never moves onto an unverified grasp;
+- **a guard on stiff arms**: a stiff arm that pushes near a torque limit complies again;
 - **wrist-roll relief** of a gripping compliant arm (`execute.motion.wrist_relief`), from
   its motor current;
 - **leg relief** (`execute.motion.leg_relief`): while a stance leg's joint pushes near its
@@ -62,6 +63,7 @@ from execute.play.player import PlayerTick, TrajectoryPlayer, min_jerk
 from ladders.geometry import LadderGeometry
 from ladders.spec import LadderSpec
 from robot.joints import ARM_JOINTS, FINGER_JOINTS, JOINT_NAMES, joint_indices
+from robot.limits import joint_limits
 from robot.plan_sidecar import PlanSidecar, Segment, segment_of_lines
 
 __all__ = ["MotionLayer"]
@@ -77,6 +79,12 @@ SEARCH_PATTERN = ((1, 0), (0, 1), (0, -1), (-1, 0), (2, 0), (1, 1), (1, -1), (-2
 MIN_CORRECTION_M = 0.01
 #: Two targets closer than this are the same [m].
 SAME_TARGET_M = 0.005
+#: A stiff arm whose motor currents say a joint has pushed harder than this share of its
+#: torque limit for `STIFF_ARM_YIELD_S` complies again: its open hand pushes on the rail
+#: or a rung (a stiff re-reach on `stair` tripped a shoulder's board so, 2026-11-27; a
+#: board trips at 0.99 held for 0.5 s). The wait lets the stiff reach's own start pass.
+STIFF_ARM_YIELD = 0.8
+STIFF_ARM_YIELD_S = 0.2
 
 
 def _side(limb: str) -> str:
@@ -167,6 +175,9 @@ class MotionLayer:
         self._regrasp: _Regrasp | None = None
         self._open_fingers: set[str] = set()
         self._stiff_arms: set[str] = set()  # arms held in position mode until they grip
+        self._yielded: set[str] = set()  # stiff arms that pushed on something, until they grip
+        self._pushing_s: dict[str, float] = {}  # stiff arm → how long it has pushed hard [s]
+        self._torque_limit_nm = joint_limits(robot).torque_max_nm
         self.events: list[MotionEvent] = []
         self.stop: MotionStop | None = None
         self.estimate: BodyEstimate | None = None
@@ -388,7 +399,8 @@ class MotionLayer:
         elif g.phase == "arrive":
             lag = self._palm_lag_m(g.side, s)
             if lag > cfg.arrival_tolerance_m and elapsed >= cfg.arrival_timeout_s \
-                    and g.side not in self._stiff_arms and self._stiff_in_air(g):
+                    and g.side not in self._stiff_arms | self._yielded \
+                    and self._stiff_in_air(g):
                 # the compliant arm cannot carry itself to the hold: it finishes the reach
                 # in position mode, as it moved in the air, until its grasp is verified
                 self._stiff_arms.add(g.side)
@@ -428,7 +440,7 @@ class MotionLayer:
                               f"{'es' if g.tries != 1 else ''} for {g.rail}: the weight was "
                               "not moved onto it")
                 return
-            if g.side not in self._stiff_arms and self._stiff_in_air(g):
+            if g.side not in self._stiff_arms | self._yielded and self._stiff_in_air(g):
                 # a hand that closed on nothing is in the air: a mixed arm re-reaches in
                 # position mode, as it moved through the air, until its grasp is verified
                 # (compliant, an open hand sagged 3–4 cm below each new target on ship)
@@ -447,6 +459,26 @@ class MotionLayer:
             self._open_fingers.discard(g.side)
             g.phase, g.since_s = "close", now
 
+    def _guard_stiff_arms(self, s: SensedState, dt: float) -> None:
+        """A stiff arm one of whose joints has pushed past `STIFF_ARM_YIELD` of its limit
+        (motor current) for `STIFF_ARM_YIELD_S` complies again until its grasp is
+        verified: an open hand moved in position mode can meet the rail or a rung."""
+        torque = self.wrist_relief.motors.torque_nm(s.cur_a)
+        for side in sorted(self._stiff_arms):
+            cols = self._arm_cols[side]
+            ratio = np.abs(torque[cols]) / self._torque_limit_nm[cols]
+            k = int(np.argmax(ratio))
+            pushing = self._pushing_s.get(side, 0.0) + dt if ratio[k] > STIFF_ARM_YIELD else 0.0
+            self._pushing_s[side] = pushing
+            if pushing >= STIFF_ARM_YIELD_S:
+                self._stiff_arms.discard(side)
+                self._yielded.add(side)
+                self._pushing_s.pop(side)
+                self._event(MotionEventKind.STIFF_REACH, f"{side}_hand", 0.0,
+                            f"{JOINT_NAMES[cols[k]]} pushed at {ratio[k]:.0%} of its torque "
+                            f"limit for {pushing:.2f} s: the arm complies again until its "
+                            "grasp is verified")
+
     def _settle_offset(self, limb: str) -> None:
         """A time-based offset that has arrived stays while the limb holds: index it by
         line again."""
@@ -458,6 +490,7 @@ class MotionLayer:
     def _grasp_verified(self, g: _Regrasp) -> None:
         limb = f"{g.side}_hand"
         self._stiff_arms.discard(g.side)  # on the rail: the plan's compliance again
+        self._yielded.discard(g.side)
         palm = self.estimate.palm_m[g.side]
         self._verified_segments.add((g.segment, g.side))
         self._settle_offset(limb)
@@ -495,6 +528,7 @@ class MotionLayer:
         self._now = now_s
         s = SensedState.from_sample(state_sample)
         self.estimate = self.estimator.update(s)
+        self._guard_stiff_arms(s, 0.0 if self._last_now is None else now_s - self._last_now)
         if self._regrasp is not None:
             self._update_regrasp(s)
         tick = self.player.step(now_s, s.pos_rad)

@@ -47,8 +47,7 @@ class LegRelief:
                  motors: MotorTable | None = None):
         self.model = model
         self.limit_nm = joint_limits(robot).torque_max_nm
-        motors = motors or motor_table()
-        self._nm_per_a = motors.efficiency * motors.gear * motors.kt_nm_per_a
+        self.motors = motors or motor_table()
         self._leg_cols = {side: np.array(joint_indices(LEG_JOINTS[side]))
                           for side in LEG_JOINTS}
         self.onset, self.release = onset_fraction, release_fraction
@@ -63,7 +62,7 @@ class LegRelief:
         if not stance_sides:
             return 0.0, -1
         cols = np.concatenate([self._leg_cols[s] for s in stance_sides])
-        share = np.abs(cur_a[cols] * self._nm_per_a[cols]) / self.limit_nm[cols]
+        share = np.abs(self.motors.torque_nm(cur_a)[cols]) / self.limit_nm[cols]
         k = int(np.argmax(share))
         return float(share[k]), int(cols[k])
 

@@ -49,8 +49,7 @@ class WristRelief:
         j = joint
         off = self.offset_rad.get(j, 0.0)
         if holding:
-            torque = float(cur_a[j] * self.motors.efficiency[j] * self.motors.gear[j]
-                           * self.motors.kt_nm_per_a[j])
+            torque = float(self.motors.torque_nm(cur_a)[j])
             if abs(torque) > self.relief_fraction * self.limit_nm[j]:
                 # the loop pushes with +τ towards a reference above the joint: give way
                 off -= math.copysign(self.speed * dt_s, torque)

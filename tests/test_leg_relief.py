@@ -1,0 +1,98 @@
+"""Leg relief: the gripping arms lift more while a stance leg's joint nears its limit."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from execute.motion.leg_relief import LegRelief
+from execute.motion.robot_model import MotionRobotModel
+from robot.joints import ARM_JOINTS, JOINT_INDEX, LEG_JOINTS, NUM_JOINTS
+from robot.limits import joint_limits
+from robot.motors import motor_table
+
+TICK_S = 0.005
+
+
+@pytest.fixture(scope="module")
+def model():
+    return MotionRobotModel()
+
+
+def _current_for(joint: str, share: float) -> np.ndarray:
+    """Motor currents [A] with ``joint`` pushing at ``share`` of its torque limit."""
+    m, c = motor_table(), JOINT_INDEX[joint]
+    cur = np.zeros(NUM_JOINTS)
+    cur[c] = m.current_a(share * joint_limits().torque_max_nm)[c]
+    return cur
+
+
+def _climbing_arms() -> np.ndarray:
+    q = np.zeros(NUM_JOINTS)
+    for side, sign in (("left", 1.0), ("right", -1.0)):
+        s = side[0].upper()
+        q[JOINT_INDEX[f"{s}SP"]], q[JOINT_INDEX[f"{s}SR"]] = -1.2, 0.2 * sign
+        q[JOINT_INDEX[f"{s}EB"]] = -0.8
+    return q
+
+
+def test_force_torques_are_the_palms_virtual_work(model):
+    """Jᵀf·dq equals f·dp for a small arm motion (the Jacobian, its frame and its sign)."""
+    q = _climbing_arms()
+    f = np.array([10.0, -20.0, 50.0])
+    tau = model.force_torques(q, np.eye(3), "left_hand", f)
+    rng = np.random.default_rng(3)
+    dq = np.zeros(NUM_JOINTS)
+    cols = [JOINT_INDEX[n] for n in ARM_JOINTS["left"]]
+    dq[cols] = rng.normal(scale=1e-4, size=len(cols))
+    p0 = model.frame_in_pelvis(q, "L_palm")[:3, 3]
+    p1 = model.frame_in_pelvis(q + dq, "L_palm")[:3, 3]
+    assert tau @ dq == pytest.approx(f @ (p1 - p0), rel=1e-3)
+    legs = [JOINT_INDEX[n] for n in LEG_JOINTS["left"] + LEG_JOINTS["right"]]
+    assert not tau[legs].any()  # a force at the palm loads the arm's joints only
+
+
+def test_the_lift_grows_above_onset_holds_between_and_shrinks_below_release(model):
+    relief = LegRelief(model, onset_fraction=0.85, release_fraction=0.75,
+                       rate_n_per_s=40.0, max_lift_n=30.0)
+    hot, warm, cool = (_current_for("LKN", s) for s in (0.92, 0.8, 0.5))
+    for _ in range(100):  # 0.5 s at 40 N/s
+        relief.update(["left"], True, hot, TICK_S)
+    assert relief.lift_n == pytest.approx(20.0)
+    for _ in range(200):
+        relief.update(["left"], True, hot, TICK_S)
+    assert relief.lift_n == pytest.approx(30.0)  # bounded
+    assert relief.peak_joint == "LKN"
+    for _ in range(100):
+        relief.update(["left"], True, warm, TICK_S)
+    assert relief.lift_n == pytest.approx(30.0)  # hysteresis: neither grows nor shrinks
+    for _ in range(100):
+        relief.update(["left"], True, cool, TICK_S)
+    assert relief.lift_n == pytest.approx(10.0)
+
+
+def test_no_lift_without_a_gripping_arm_or_from_a_swing_leg(model):
+    relief = LegRelief(model)
+    hot = _current_for("LKN", 0.95)
+    for _ in range(100):
+        relief.update(["left"], False, hot, TICK_S)  # no compliant hand on a rail
+        relief.update(["right"], True, hot, TICK_S)  # the loaded knee is not in stance
+    assert relief.lift_n == 0.0
+
+
+def test_the_lift_is_a_push_down_on_each_gripping_rail(model):
+    """The relief's feed-forward is −Jᵀf, f the rail's upward push on each hand, on the
+    gripping arms' columns alone."""
+    relief = LegRelief(model)
+    relief.lift_n = 40.0
+    q = _climbing_arms()
+    ff = relief.feedforward_nm(["left", "right"], q, np.eye(3))
+    for side in ("left", "right"):
+        cols = list(model.chains[f"{side}_hand"].columns)
+        up = model.force_torques(q, np.eye(3), f"{side}_hand", np.array([0.0, 0.0, 20.0]))
+        np.testing.assert_allclose(ff[cols], -up[cols])
+    ff_left = relief.feedforward_nm(["left"], q, np.eye(3))
+    right = [JOINT_INDEX[n] for n in ARM_JOINTS["right"]]
+    assert not ff_left[right].any()
+    cols = list(model.chains["left_hand"].columns)
+    np.testing.assert_allclose(ff_left[cols], 2 * ff[cols])  # one hand takes it all
