@@ -33,8 +33,10 @@ demo: install
 		status=$$?; [ $$status -le 1 ] || exit $$status; \
 		echo "validate-plan verdict written to demo-out/drc.result.json (exit $$status)"
 
+# One pytest worker per core (pytest-xdist); a test file's tests share a worker, so its
+# module fixtures (a planned reach, a simulated climb) are built once.
 test: install
-	MUJOCO_GL=egl $(BIN)/python -m pytest -q
+	MUJOCO_GL=egl $(BIN)/python -m pytest -q -n auto --dist loadfile
 
 bench: install
 	$(BIN)/python -m bench

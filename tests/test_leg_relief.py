@@ -80,19 +80,56 @@ def test_no_lift_without_a_gripping_arm_or_from_a_swing_leg(model):
     assert relief.lift_n == 0.0
 
 
-def test_the_lift_is_a_push_down_on_each_gripping_rail(model):
-    """The relief's feed-forward is −Jᵀf, f the rail's upward push on each hand, on the
-    gripping arms' columns alone."""
-    relief = LegRelief(model)
-    relief.lift_n = 40.0
+def _static_knee_torque(model, q, hand_force):
+    """LKN's torque [N·m] holding ``q`` on the left sole alone, with ``hand_force`` (world)
+    of the environment on the left palm: the sole's wrench from the free flyer's rows."""
+    import pinocchio as pin
+
+    pq = model.configuration(q)
+    m, d = model.model, model.data
+    pin.computeJointJacobians(m, d, pq)
+    pin.updateFramePlacements(m, d)
+    g = pin.computeGeneralizedGravity(m, d, pq)
+    J_sole = pin.getFrameJacobian(m, d, m.getFrameId("L_sole"), pin.LOCAL_WORLD_ALIGNED)
+    J_palm = pin.getFrameJacobian(m, d, m.getFrameId("L_palm"), pin.LOCAL_WORLD_ALIGNED)
+    hand = J_palm[:3].T @ hand_force
+    w_sole = np.linalg.solve(J_sole[:, :6].T, g[:6] - hand[:6])
+    tau = g - J_sole.T @ w_sole - hand
+    return float(tau[m.joints[m.getJointId("LKN")].idx_v])
+
+
+def test_the_stance_torque_gradient_is_the_statics_of_one_foot(model):
+    """∂τ/∂f from the sole's Jacobian equals a static solve's difference quotient."""
     q = _climbing_arms()
+    q[JOINT_INDEX["LHP"]], q[JOINT_INDEX["LKN"]], q[JOINT_INDEX["LAP"]] = -0.5, 1.0, -0.5
+    grad = model.stance_torque_gradient(q, np.eye(3), JOINT_INDEX["LKN"], "left_foot",
+                                        "left_hand")
+    base = _static_knee_torque(model, q, np.zeros(3))
+    for axis in np.eye(3):
+        assert _static_knee_torque(model, q, 10.0 * axis) - base == \
+            pytest.approx(10.0 * grad @ axis, abs=1e-6)
+
+
+def test_the_lift_pulls_each_gripping_hand_the_way_that_unloads_the_joint(model):
+    """The relief's feed-forward is −Jᵀf on the gripping arms' columns alone; f never
+    points down, and it lowers the loaded knee's |τ|."""
+    q = _climbing_arms()
+    q[JOINT_INDEX["LHP"]], q[JOINT_INDEX["LKN"]], q[JOINT_INDEX["LAP"]] = -0.5, 1.0, -0.5
+    relief = LegRelief(model, max_lift_n=40.0)
+    hot = _current_for("LKN", -0.95)  # the knee holds the bent leg: negative torque
+    for _ in range(400):
+        relief.update(["left"], True, hot, TICK_S)
+    assert relief.lift_n == pytest.approx(40.0)
     ff = relief.feedforward_nm(["left", "right"], q, np.eye(3))
     for side in ("left", "right"):
+        d = relief.direction(q, np.eye(3), "left_foot", f"{side}_hand")
+        assert d[2] >= 0.0 and np.linalg.norm(d) == pytest.approx(1.0)
+        grad = model.stance_torque_gradient(q, np.eye(3), JOINT_INDEX["LKN"], "left_foot",
+                                            f"{side}_hand")
+        assert grad @ d > 0.0  # the negative knee torque moves towards zero
         cols = list(model.chains[f"{side}_hand"].columns)
-        up = model.force_torques(q, np.eye(3), f"{side}_hand", np.array([0.0, 0.0, 20.0]))
-        np.testing.assert_allclose(ff[cols], -up[cols])
+        push = model.force_torques(q, np.eye(3), f"{side}_hand", 20.0 * d)
+        np.testing.assert_allclose(ff[cols], -push[cols])
     ff_left = relief.feedforward_nm(["left"], q, np.eye(3))
     right = [JOINT_INDEX[n] for n in ARM_JOINTS["right"]]
     assert not ff_left[right].any()
-    cols = list(model.chains["left_hand"].columns)
-    np.testing.assert_allclose(ff_left[cols], 2 * ff[cols])  # one hand takes it all

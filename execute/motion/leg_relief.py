@@ -12,9 +12,16 @@ The motor current says how hard each leg joint pushes (``τ = η·gear·Kt·I``,
 `robot.motors`). While the largest share of its limit over the stance legs' joints is
 above ``onset_fraction``, the hands' extra lift grows at ``rate_n_per_s``; below
 ``release_fraction`` it shrinks at that rate; it is bounded by ``max_lift_n``. The lift is
-a vertical force of the rail on each gripping compliant hand, split evenly, sent as
-feed-forward torques ``−Jᵀ f`` on the arm's compliant joints at the sensed configuration
-and the IMU's tilt; each arm's PWM clamp (the daemon's) bounds what it can add.
+a force of the rail on each gripping compliant hand, split evenly, sent as feed-forward
+torques ``−Jᵀ f`` on the arm's compliant joints at the sensed configuration and the IMU's
+tilt; each arm's PWM clamp (the daemon's) bounds what it can add.
+
+Its direction is the one that unloads the joint that called for it fastest, per newton:
+the stance foot takes the reaction, so the joint's torque changes along
+`MotionRobotModel.stance_torque_gradient`. A hand never pushes the body down (the
+direction's downward part is dropped): that would load the feet. A vertical lift alone
+did not relieve knees on `ship`, where the knee's lever is mostly horizontal
+(docs/decisions/leg-relief.md).
 """
 
 from __future__ import annotations
@@ -56,6 +63,8 @@ class LegRelief:
         #: The largest lift of the run [N] and the leg joint that called for it.
         self.peak_lift_n = 0.0
         self.peak_joint = ""
+        #: The column and torque sign of the joint the lift relieves.
+        self.joint_col, self.joint_sign = -1, 0.0
 
     def leg_load(self, stance_sides: list[str], cur_a: np.ndarray) -> tuple[float, int]:
         """The largest |τ|/limit over the stance legs' joints, and its column (-1: none)."""
@@ -71,6 +80,8 @@ class LegRelief:
         """The lift after one tick [N]. ``can_lift``: a compliant hand grips a rail."""
         share, col = self.leg_load(stance_sides, cur_a)
         if can_lift and share > self.onset:
+            self.joint_col = col
+            self.joint_sign = float(np.sign(self.motors.torque_nm(cur_a)[col]))
             self.lift_n = min(self.max_lift_n, self.lift_n + self.rate_n_per_s * dt_s)
             if self.lift_n > self.peak_lift_n:
                 self.peak_lift_n, self.peak_joint = self.lift_n, JOINT_NAMES[col]
@@ -78,16 +89,29 @@ class LegRelief:
             self.lift_n = max(0.0, self.lift_n - self.rate_n_per_s * dt_s)
         return self.lift_n
 
+    def direction(self, q_sensed_rad: np.ndarray, R_tilt: np.ndarray, foot: str,
+                  hand: str) -> np.ndarray:
+        """Unit direction (world) of the rail's push on ``hand`` that unloads the relieved
+        joint fastest, without a downward part; straight up if it has none."""
+        gradient = self.model.stance_torque_gradient(q_sensed_rad, R_tilt, self.joint_col,
+                                                     foot, hand)
+        d = -self.joint_sign * gradient
+        d[2] = max(d[2], 0.0)
+        length = float(np.linalg.norm(d))
+        return d / length if length > 1e-9 else np.array([0.0, 0.0, 1.0])
+
     def feedforward_nm(self, sides: list[str], q_sensed_rad: np.ndarray,
                        R_tilt: np.ndarray) -> np.ndarray:
         """Feed-forward torques by column [N·m] that make the rail push each hand of
-        ``sides`` up by its share of the lift (zero off their arms)."""
+        ``sides`` by its share of the lift, along `direction` (zero off their arms)."""
         out = np.zeros(len(q_sensed_rad))
-        if self.lift_n <= 0.0 or not sides:
+        if self.lift_n <= 0.0 or not sides or self.joint_col < 0:
             return out
-        per_hand = np.array([0.0, 0.0, self.lift_n / len(sides)])
+        foot = f"{'left' if JOINT_NAMES[self.joint_col].startswith('L') else 'right'}_foot"
         for side in sides:
-            torque = self.model.force_torques(q_sensed_rad, R_tilt, f"{side}_hand", per_hand)
+            direction = self.direction(q_sensed_rad, R_tilt, foot, f"{side}_hand")
+            force = direction * (self.lift_n / len(sides))
+            torque = self.model.force_torques(q_sensed_rad, R_tilt, f"{side}_hand", force)
             cols = list(self.model.chains[f"{side}_hand"].columns)
             out[cols] = -torque[cols]
         return out

@@ -109,6 +109,29 @@ class MotionRobotModel:
         out[self._have] = jt[self._v_cols]
         return out
 
+    def stance_torque_gradient(self, q_cols_rad: np.ndarray, R_world_pelvis: np.ndarray,
+                               joint_col: int, foot: str, hand: str) -> np.ndarray:
+        """∂τ/∂f (3,) [N·m/N]: how the torque of leg joint ``joint_col`` changes with a
+        force f (world frame) of the environment on ``hand``'s palm, when the stance
+        foot ``foot`` (a limb name) takes its reaction.
+
+        The foot's wrench changes by ``−(f, r × f)`` about its sole (r from sole to palm),
+        and a leg joint's torque is ``g − Jᵀw`` over its foot's wrench: ∂τ/∂f = a + b × r,
+        with (a, b) the joint's column of the sole's Jacobian.
+        """
+        T = np.eye(4)
+        T[:3, :3] = R_world_pelvis
+        q = self.configuration(q_cols_rad, T)
+        m, d = self.model, self.data
+        pin.computeJointJacobians(m, d, q)
+        pin.updateFramePlacements(m, d)
+        sole = self._frame_id[self.chains[foot].frame]
+        palm = self._frame_id[self.chains[hand].frame]
+        jacobian = pin.getFrameJacobian(m, d, sole, pin.LOCAL_WORLD_ALIGNED)
+        column = jacobian[:, self._v_of_col[joint_col]]
+        r = d.oMf[palm].translation - d.oMf[sole].translation
+        return column[:3] + np.cross(column[3:], r)
+
     def com_m(self, q_cols_rad: np.ndarray, T_world_pelvis: np.ndarray) -> np.ndarray:
         """Whole-body centre of mass in the world [m]."""
         return np.array(pin.centerOfMass(self.model, self.data,
