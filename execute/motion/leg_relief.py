@@ -9,8 +9,12 @@ leg takes whatever the arms do not. On a one-foot stance the knee then climbs pa
 limit and its board trips (a stair mount: planned 48 N·m, 60 N·m in MuJoCo).
 
 The motor current says how hard each leg joint pushes (``τ = η·gear·Kt·I``,
-`robot.motors`). While the largest share of its limit over the stance legs' joints is
-above ``onset_fraction``, the hands' extra lift grows at ``rate_n_per_s``; below
+`robot.motors`). The joints watched are those that carry the body's weight on the leg,
+the knee and the hip pitch (`WEIGHT_JOINTS`). The ankles' and hip rolls' torques say
+where the foot's centre of pressure and the body's roll sit; the hand push that would
+unload them is mostly horizontal and bends the grip (DRC seed 4: an ankle-pitch relief at
+272 s, then the right grip bent open at 292 s). While the largest share of its limit
+over the stance legs' watched joints is above ``onset_fraction``, the hands' extra lift grows at ``rate_n_per_s``; below
 ``release_fraction`` it shrinks at that rate; it is bounded by ``max_lift_n``. The lift is
 a force of the rail on each gripping compliant hand, split evenly, sent as feed-forward
 torques ``−Jᵀ f`` on the arm's compliant joints at the sensed configuration and the IMU's
@@ -29,11 +33,14 @@ from __future__ import annotations
 import numpy as np
 
 from execute.motion.robot_model import MotionRobotModel
-from robot.joints import JOINT_NAMES, LEG_JOINTS, joint_indices
+from robot.joints import JOINT_NAMES, joint_indices
 from robot.limits import joint_limits
 from robot.motors import MotorTable, motor_table
 
-__all__ = ["LegRelief"]
+__all__ = ["WEIGHT_JOINTS", "LegRelief"]
+
+#: Per leg, the joints whose load is the body's weight on it (module docstring).
+WEIGHT_JOINTS = {"left": ("LHP", "LKN"), "right": ("RHP", "RKN")}
 
 
 class LegRelief:
@@ -55,8 +62,8 @@ class LegRelief:
         self.model = model
         self.limit_nm = joint_limits(robot).torque_max_nm
         self.motors = motors or motor_table()
-        self._leg_cols = {side: np.array(joint_indices(LEG_JOINTS[side]))
-                          for side in LEG_JOINTS}
+        self._leg_cols = {side: np.array(joint_indices(WEIGHT_JOINTS[side]))
+                          for side in WEIGHT_JOINTS}
         self.onset, self.release = onset_fraction, release_fraction
         self.rate_n_per_s, self.max_lift_n = rate_n_per_s, max_lift_n
         self.lift_n = 0.0
@@ -67,7 +74,8 @@ class LegRelief:
         self.joint_col, self.joint_sign = -1, 0.0
 
     def leg_load(self, stance_sides: list[str], cur_a: np.ndarray) -> tuple[float, int]:
-        """The largest |τ|/limit over the stance legs' joints, and its column (-1: none)."""
+        """The largest |τ|/limit over the stance legs' `WEIGHT_JOINTS`, and its column
+        (-1: none)."""
         if not stance_sides:
             return 0.0, -1
         cols = np.concatenate([self._leg_cols[s] for s in stance_sides])
