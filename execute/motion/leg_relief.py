@@ -14,11 +14,12 @@ the knee and the hip pitch (`WEIGHT_JOINTS`). The ankles' and hip rolls' torques
 where the foot's centre of pressure and the body's roll sit; the hand push that would
 unload them is mostly horizontal and bends the grip (DRC seed 4: an ankle-pitch relief at
 272 s, then the right grip bent open at 292 s). While the largest share of its limit
-over the stance legs' watched joints is above ``onset_fraction``, the hands' extra lift grows at ``rate_n_per_s``; below
-``release_fraction`` it shrinks at that rate; it is bounded by ``max_lift_n``. The lift is
-a force of the rail on each gripping compliant hand, split evenly, sent as feed-forward
-torques ``−Jᵀ f`` on the arm's compliant joints at the sensed configuration and the IMU's
-tilt; each arm's PWM clamp (the daemon's) bounds what it can add.
+over the stance legs' watched joints is above ``onset_fraction``, the hands' extra lift
+grows at ``rate_n_per_s``; below ``release_fraction`` it shrinks at that rate; it is
+bounded by ``max_lift_n``. The lift is a force of the rail on each gripping compliant
+hand, split evenly, sent as feed-forward torques ``−Jᵀ f`` on the arm's compliant joints
+at the sensed configuration and the IMU's tilt; each arm's PWM clamp (the daemon's)
+bounds what it can add.
 
 Its direction is the one that unloads the joint that called for it fastest, per newton:
 the stance foot takes the reaction, so the joint's torque changes along
