@@ -14,6 +14,7 @@ import json
 import os
 import shutil
 import subprocess
+import tempfile
 import time
 import urllib.request
 from pathlib import Path
@@ -35,14 +36,17 @@ class Chromium:
     def __init__(self, profile: Path, size_px: tuple[int, int] = (1400, 1300)):
         from websockets.sync.client import connect
 
+        self._socket_dir = tempfile.mkdtemp(prefix="chromium-")
         self.proc = subprocess.Popen(
             [chromium_path(), "--headless", "--no-sandbox", "--disable-gpu",
              "--hide-scrollbars", "--no-first-run", "--remote-debugging-port=0",
              "--remote-allow-origins=*", f"--user-data-dir={profile}",
              f"--window-size={size_px[0]},{size_px[1]}", "about:blank"],
             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-            # its singleton socket folders go with the profile, not into /tmp for good
-            env={**os.environ, "TMPDIR": str(profile)})
+            # its singleton socket folders go into a short folder of their own, removed on
+            # close (not into /tmp for good); a socket's path must stay under 108
+            # characters, which a profile deep in pytest-xdist's tmp tree exceeds
+            env={**os.environ, "TMPDIR": self._socket_dir})
         port_file = profile / "DevToolsActivePort"
         deadline = time.monotonic() + 60
         while not (port_file.exists() and port_file.read_text().strip()):
@@ -65,6 +69,7 @@ class Chromium:
         except subprocess.TimeoutExpired:
             self.proc.kill()
             self.proc.wait()
+        shutil.rmtree(self._socket_dir, ignore_errors=True)
 
     def call(self, method: str, **params) -> dict:
         """One protocol command; its result (events on the way are dropped)."""
