@@ -19,12 +19,13 @@ def model():
     return MotionRobotModel()
 
 
-def _current_for(joint: str, share: float) -> np.ndarray:
-    """Motor currents [A] with ``joint`` pushing at ``share`` of its torque limit."""
+def _torque_for(joint: str, share: float) -> np.ndarray:
+    """Sensed joint torques [N·m] (from motor currents) with ``joint`` pushing at
+    ``share`` of its torque limit."""
     m, c = motor_table(), JOINT_INDEX[joint]
     cur = np.zeros(NUM_JOINTS)
     cur[c] = m.current_a(share * joint_limits().torque_max_nm)[c]
-    return cur
+    return m.torque_nm(cur)
 
 
 def _climbing_arms() -> np.ndarray:
@@ -55,7 +56,7 @@ def test_force_torques_are_the_palms_virtual_work(model):
 def test_the_lift_grows_above_onset_holds_between_and_shrinks_below_release(model):
     relief = LegRelief(model, onset_fraction=0.85, release_fraction=0.75,
                        rate_n_per_s=40.0, max_lift_n=30.0)
-    hot, warm, cool = (_current_for("LKN", s) for s in (0.92, 0.8, 0.5))
+    hot, warm, cool = (_torque_for("LKN", s) for s in (0.92, 0.8, 0.5))
     for _ in range(100):  # 0.5 s at 40 N/s
         relief.update(["left"], True, hot, TICK_S)
     assert relief.lift_n == pytest.approx(20.0)
@@ -73,7 +74,7 @@ def test_the_lift_grows_above_onset_holds_between_and_shrinks_below_release(mode
 
 def test_no_lift_without_a_gripping_arm_or_from_a_swing_leg(model):
     relief = LegRelief(model)
-    hot = _current_for("LKN", 0.95)
+    hot = _torque_for("LKN", 0.95)
     for _ in range(100):
         relief.update(["left"], False, hot, TICK_S)  # no compliant hand on a rail
         relief.update(["right"], True, hot, TICK_S)  # the loaded knee is not in stance
@@ -116,7 +117,7 @@ def test_the_lift_pulls_each_gripping_hand_the_way_that_unloads_the_joint(model)
     q = _climbing_arms()
     q[JOINT_INDEX["LHP"]], q[JOINT_INDEX["LKN"]], q[JOINT_INDEX["LAP"]] = -0.5, 1.0, -0.5
     relief = LegRelief(model, max_lift_n=40.0)
-    hot = _current_for("LKN", -0.95)  # the knee holds the bent leg: negative torque
+    hot = _torque_for("LKN", -0.95)  # the knee holds the bent leg: negative torque
     for _ in range(400):
         relief.update(["left"], True, hot, TICK_S)
     assert relief.lift_n == pytest.approx(40.0)

@@ -360,7 +360,6 @@ def test_a_stiff_arm_that_pushes_on_something_complies_again(reach):
     """A stiff arm whose shoulder current says it pushes at 90 % of its limit complies
     again after 0.2 s; a shorter push (the stiff reach's own start) leaves it stiff."""
     from execute.motion.layer import STIFF_ARM_YIELD_S, MotionLayer
-    from execute.motion.sensed_state import SensedState
     from execute.play.player import PlayerOptions, TrajectoryPlayer
     from robot.limits import joint_limits
     from robot.motors import motor_table
@@ -371,12 +370,9 @@ def test_a_stiff_arm_that_pushes_on_something_complies_again(reach):
     lsp = JOINT_INDEX["LSP"]
     pushing = np.zeros(NUM_JOINTS)
     pushing[lsp] = motor_table().current_a(0.9 * joint_limits().torque_max_nm)[lsp]
-    sample = new_sample(STATE_DTYPE)
-    sample["pos"] = traj[0]
 
-    def sensed(cur_a):
-        sample["cur"] = cur_a
-        return SensedState.from_sample(sample)
+    def sensed(cur_a):  # the joint torques the layer reads from the currents each tick
+        return layer.motors.torque_nm(cur_a)
 
     layer._stiff_arms.add("left")
     for _ in range(int(0.1 / 0.005)):

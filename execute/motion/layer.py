@@ -64,6 +64,7 @@ from ladders.geometry import LadderGeometry
 from ladders.spec import LadderSpec
 from robot.joints import ARM_JOINTS, FINGER_JOINTS, JOINT_NAMES, joint_indices
 from robot.limits import joint_limits
+from robot.motors import motor_table
 from robot.plan_sidecar import PlanSidecar, Segment, segment_of_lines
 
 __all__ = ["MotionLayer"]
@@ -178,6 +179,9 @@ class MotionLayer:
         self._yielded: set[str] = set()  # stiff arms that pushed on something, until they grip
         self._pushing_s: dict[str, float] = {}  # stiff arm → how long it has pushed hard [s]
         self._torque_limit_nm = joint_limits(robot).torque_max_nm
+        self.motors = motor_table()
+        #: This tick's joint torques from the motor currents [N·m], by column.
+        self._sensed_torque_nm = np.zeros(len(JOINT_NAMES))
         self.events: list[MotionEvent] = []
         self.stop: MotionStop | None = None
         self.estimate: BodyEstimate | None = None
@@ -459,14 +463,14 @@ class MotionLayer:
             self._open_fingers.discard(g.side)
             g.phase, g.since_s = "close", now
 
-    def _guard_stiff_arms(self, s: SensedState, dt: float) -> None:
+    def _guard_stiff_arms(self, torque_nm: np.ndarray, dt: float) -> None:
         """A stiff arm one of whose joints has pushed past `STIFF_ARM_YIELD` of its limit
         (motor current) for `STIFF_ARM_YIELD_S` complies again until its grasp is
-        verified: an open hand moved in position mode can meet the rail or a rung."""
-        torque = self.wrist_relief.motors.torque_nm(s.cur_a)
+        verified: an open hand moved in position mode can meet the rail or a rung.
+        ``torque_nm``: the sensed joint torques by column [N·m]."""
         for side in sorted(self._stiff_arms):
             cols = self._arm_cols[side]
-            ratio = np.abs(torque[cols]) / self._torque_limit_nm[cols]
+            ratio = np.abs(torque_nm[cols]) / self._torque_limit_nm[cols]
             k = int(np.argmax(ratio))
             pushing = self._pushing_s.get(side, 0.0) + dt if ratio[k] > STIFF_ARM_YIELD else 0.0
             self._pushing_s[side] = pushing
@@ -528,7 +532,9 @@ class MotionLayer:
         self._now = now_s
         s = SensedState.from_sample(state_sample)
         self.estimate = self.estimator.update(s)
-        self._guard_stiff_arms(s, 0.0 if self._last_now is None else now_s - self._last_now)
+        self._sensed_torque_nm = self.motors.torque_nm(s.cur_a)
+        self._guard_stiff_arms(self._sensed_torque_nm,
+                               0.0 if self._last_now is None else now_s - self._last_now)
         if self._regrasp is not None:
             self._update_regrasp(s)
         tick = self.player.step(now_s, s.pos_rad)
@@ -566,7 +572,8 @@ class MotionLayer:
             if gripping and side not in self._stiff_arms:
                 lifting.append(side)
             wrist_roll = WRIST_ROLL[side]
-            ref[wrist_roll] += self.wrist_relief.update(wrist_roll, gripping, s.cur_a, dt)
+            ref[wrist_roll] += self.wrist_relief.update(wrist_roll, gripping,
+                                                        self._sensed_torque_nm, dt)
             share = self.config.holding_arm_stiffness
             if gripping and share < 1.0:
                 soft = [c for c in cols if c != wrist_roll]
@@ -593,17 +600,18 @@ class MotionLayer:
         """``ff`` plus the leg relief's lift on the ``lifting`` arms (`LegRelief`)."""
         stance = [side for side in SIDES if f"{side}_foot" in seg.holds
                   and self.estimate.standing.get(side, False)]
-        before = self.leg_relief.lift_n
-        lift = self.leg_relief.update(stance, bool(lifting), s.cur_a, dt)
+        relief = self.leg_relief
+        before = relief.lift_n
+        lift = relief.update(stance, bool(lifting), self._sensed_torque_nm, dt)
         if before == 0.0 and lift > 0.0:
-            share, col = self.leg_relief.leg_load(stance, s.cur_a)
             self._event(MotionEventKind.LEG_RELIEF, "", 0.0,
-                        f"{JOINT_NAMES[col]} at {share:.0%} of its torque limit: the "
+                        f"{JOINT_NAMES[relief.joint_col]} at {relief.load_share:.0%} of its "
+                        "torque limit: the "
                         f"{' and '.join(lifting)} arm{'s' if len(lifting) > 1 else ''} "
                         "lift more")
         if lift == 0.0:
             return ff
-        return ff + self.leg_relief.feedforward_nm(lifting, s.pos_rad, self.estimate.R_tilt)
+        return ff + relief.feedforward_nm(lifting, s.pos_rad, self.estimate.R_tilt)
 
     # ------------------------------------------------------------------ report
     def report(self) -> dict:
@@ -619,9 +627,9 @@ class MotionLayer:
                        "grasp_retries": self.config.grasp_retries},
             "counts": counts,
             "ladder_shift_m": [round(float(v), 4) for v in self.ladder.shift_m],
+            "ladder_yaw_rad": round(self.ladder.yaw_rad, 4),
             "leg_relief_peak_n": round(self.leg_relief.peak_lift_n, 1),
             "leg_relief_joint": self.leg_relief.peak_joint,
-            "ladder_yaw_rad": round(self.ladder.yaw_rad, 4),
             "stop": None if self.stop is None else dataclasses.asdict(self.stop),
             "events": [ev.to_json() for ev in self.events],
         }

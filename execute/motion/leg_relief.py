@@ -9,17 +9,18 @@ leg takes whatever the arms do not. On a one-foot stance the knee then climbs pa
 limit and its board trips (a stair mount: planned 48 N·m, 60 N·m in MuJoCo).
 
 The motor current says how hard each leg joint pushes (``τ = η·gear·Kt·I``,
-`robot.motors`). The joints watched are those that carry the body's weight on the leg,
-the knee and the hip pitch (`WEIGHT_JOINTS`). The ankles' and hip rolls' torques say
-where the foot's centre of pressure and the body's roll sit; the hand push that would
-unload them is mostly horizontal and bends the grip (DRC seed 4: an ankle-pitch relief at
-272 s, then the right grip bent open at 292 s). While the largest share of its limit
-over the stance legs' watched joints is above ``onset_fraction``, the hands' extra lift
-grows at ``rate_n_per_s``; below ``release_fraction`` it shrinks at that rate; it is
-bounded by ``max_lift_n``. The lift is a force of the rail on each gripping compliant
-hand, split evenly, sent as feed-forward torques ``−Jᵀ f`` on the arm's compliant joints
-at the sensed configuration and the IMU's tilt; each arm's PWM clamp (the daemon's)
-bounds what it can add.
+`robot.motors.MotorTable.torque_nm`, which the motion layer applies once a tick). The
+joints watched are those that carry the body's weight on the leg, the knee and the hip
+pitch (`WEIGHT_JOINTS`). The ankles' and hip rolls' torques say where the foot's centre
+of pressure and the body's roll sit; the hand push that would unload them is mostly
+horizontal and bends the grip (DRC seed 4: an ankle-pitch relief at 272 s, then the right
+grip bent open at 292 s). While the largest share of its limit over the stance legs'
+watched joints is above ``onset_fraction``, the hands' extra lift grows at
+``rate_n_per_s``; below ``release_fraction`` it shrinks at that rate; it is bounded by
+``max_lift_n``. The lift is a force of the rail on each gripping compliant hand, split
+evenly, sent as feed-forward torques ``−Jᵀ f`` on the arm's compliant joints at the
+sensed configuration and the IMU's tilt; each arm's PWM clamp (the daemon's) bounds what
+it can add.
 
 Its direction is the one that unloads the joint that called for it fastest, per newton:
 the stance foot takes the reaction, so the joint's torque changes along
@@ -36,7 +37,6 @@ import numpy as np
 from execute.motion.robot_model import MotionRobotModel
 from robot.joints import JOINT_NAMES, joint_indices
 from robot.limits import joint_limits
-from robot.motors import MotorTable, motor_table
 
 __all__ = ["WEIGHT_JOINTS", "LegRelief"]
 
@@ -58,11 +58,9 @@ class LegRelief:
 
     def __init__(self, model: MotionRobotModel, robot: str = "drc-hubo",
                  onset_fraction: float = 0.85, release_fraction: float = 0.75,
-                 rate_n_per_s: float = 40.0, max_lift_n: float = 80.0,
-                 motors: MotorTable | None = None):
+                 rate_n_per_s: float = 40.0, max_lift_n: float = 80.0):
         self.model = model
         self.limit_nm = joint_limits(robot).torque_max_nm
-        self.motors = motors or motor_table()
         self._leg_cols = {side: np.array(joint_indices(WEIGHT_JOINTS[side]))
                           for side in WEIGHT_JOINTS}
         self.onset, self.release = onset_fraction, release_fraction
@@ -71,26 +69,27 @@ class LegRelief:
         #: The largest lift of the run [N] and the leg joint that called for it.
         self.peak_lift_n = 0.0
         self.peak_joint = ""
-        #: The column and torque sign of the joint the lift relieves.
-        self.joint_col, self.joint_sign = -1, 0.0
+        #: The leg joint the lift relieves: its column, the sign of its torque and its
+        #: leg's foot (the limb that takes the push's reaction).
+        self.joint_col, self.joint_sign, self.joint_foot = -1, 0.0, ""
+        #: The last tick's largest |τ|/limit over the stance legs' watched joints.
+        self.load_share = 0.0
 
-    def leg_load(self, stance_sides: list[str], cur_a: np.ndarray) -> tuple[float, int]:
-        """The largest |τ|/limit over the stance legs' `WEIGHT_JOINTS`, and its column
-        (-1: none)."""
-        if not stance_sides:
-            return 0.0, -1
-        cols = np.concatenate([self._leg_cols[s] for s in stance_sides])
-        share = np.abs(self.motors.torque_nm(cur_a)[cols]) / self.limit_nm[cols]
-        k = int(np.argmax(share))
-        return float(share[k]), int(cols[k])
-
-    def update(self, stance_sides: list[str], can_lift: bool, cur_a: np.ndarray,
+    def update(self, stance_sides: list[str], can_lift: bool, torque_nm: np.ndarray,
                dt_s: float) -> float:
-        """The lift after one tick [N]. ``can_lift``: a compliant hand grips a rail."""
-        share, col = self.leg_load(stance_sides, cur_a)
+        """The lift after one tick [N]. ``can_lift``: a compliant hand grips a rail;
+        ``torque_nm``: the sensed joint torques by column [N·m]."""
+        share, col, side = 0.0, -1, ""
+        for leg in stance_sides:
+            cols = self._leg_cols[leg]
+            shares = np.abs(torque_nm[cols]) / self.limit_nm[cols]
+            k = int(np.argmax(shares))
+            if shares[k] > share:
+                share, col, side = float(shares[k]), int(cols[k]), leg
+        self.load_share = share
         if can_lift and share > self.onset:
-            self.joint_col = col
-            self.joint_sign = float(np.sign(self.motors.torque_nm(cur_a)[col]))
+            self.joint_col, self.joint_foot = col, f"{side}_foot"
+            self.joint_sign = float(np.sign(torque_nm[col]))
             self.lift_n = min(self.max_lift_n, self.lift_n + self.rate_n_per_s * dt_s)
             if self.lift_n > self.peak_lift_n:
                 self.peak_lift_n, self.peak_joint = self.lift_n, JOINT_NAMES[col]
@@ -116,9 +115,8 @@ class LegRelief:
         out = np.zeros(len(q_sensed_rad))
         if self.lift_n <= 0.0 or not sides or self.joint_col < 0:
             return out
-        foot = f"{'left' if JOINT_NAMES[self.joint_col].startswith('L') else 'right'}_foot"
         for side in sides:
-            direction = self.direction(q_sensed_rad, R_tilt, foot, f"{side}_hand")
+            direction = self.direction(q_sensed_rad, R_tilt, self.joint_foot, f"{side}_hand")
             force = direction * (self.lift_n / len(sides))
             torque = self.model.force_torques(q_sensed_rad, R_tilt, f"{side}_hand", force)
             cols = list(self.model.chains[f"{side}_hand"].columns)

@@ -67,6 +67,11 @@ class MotionRobotModel:
             self.chains[f"{side}_hand"] = LimbChain(f"{side}_hand", f"{s}_palm", arm)
             self.chains[f"{side}_foot"] = LimbChain(f"{side}_foot", f"{s}_sole", leg)
         self._frame_id = {c.frame: m.getFrameId(c.frame) for c in self.chains.values()}
+        # Jacobians and frame placements of the last (joints, tilt) asked for, in a data
+        # of their own (the other methods overwrite `self.data` with other configurations):
+        # a tick asks several questions of the sensed configuration (`_kinematics_at`).
+        self._jac_data = m.createData()
+        self._jac_at: tuple[np.ndarray, np.ndarray] | None = None
 
     # ------------------------------------------------------------------ conversions
     def configuration(self, q_cols_rad: np.ndarray, T_world_pelvis: np.ndarray | None = None
@@ -79,6 +84,25 @@ class MotionRobotModel:
             q[3:7] = pin.Quaternion(T_world_pelvis[:3, :3]).coeffs()
         return q
 
+    def _tilted(self, q_cols_rad: np.ndarray, R_world_pelvis: np.ndarray) -> np.ndarray:
+        """pinocchio's q for the 40 columns, the pelvis at the origin turned by
+        ``R_world_pelvis``."""
+        T = np.eye(4)
+        T[:3, :3] = R_world_pelvis
+        return self.configuration(q_cols_rad, T)
+
+    def _kinematics_at(self, q_cols_rad: np.ndarray, R_world_pelvis: np.ndarray):
+        """`_jac_data` with joint Jacobians and frame placements at these joints and tilt,
+        computed again only when they differ from the last call's."""
+        last = self._jac_at
+        if last is None or not (np.array_equal(last[0], q_cols_rad)
+                                and np.array_equal(last[1], R_world_pelvis)):
+            d = self._jac_data
+            pin.computeJointJacobians(self.model, d, self._tilted(q_cols_rad, R_world_pelvis))
+            pin.updateFramePlacements(self.model, d)
+            self._jac_at = (np.array(q_cols_rad, dtype=float), np.array(R_world_pelvis))
+        return self._jac_data
+
     # ------------------------------------------------------------------ dynamics
     def gravity_torques(self, q_cols_rad: np.ndarray, R_world_pelvis: np.ndarray) -> np.ndarray:
         """Joint torques that hold the robot still against gravity [N·m], by column.
@@ -86,9 +110,8 @@ class MotionRobotModel:
         Each joint's torque is that of the bodies beyond it, so only the pelvis's tilt
         matters, not where it stands.
         """
-        T = np.eye(4)
-        T[:3, :3] = R_world_pelvis
-        g = pin.computeGeneralizedGravity(self.model, self.data, self.configuration(q_cols_rad, T))
+        g = pin.computeGeneralizedGravity(self.model, self.data,
+                                          self._tilted(q_cols_rad, R_world_pelvis))
         out = np.zeros(len(JOINT_NAMES))
         out[self._have] = g[self._v_cols]
         return out
@@ -98,12 +121,9 @@ class MotionRobotModel:
         """``Jᵀ f`` by column [N·m]: the generalized force of a force ``force_world_n``
         (world frame) applied at ``limb``'s end frame (its palm or sole), the pelvis
         tilted by ``R_world_pelvis``."""
-        T = np.eye(4)
-        T[:3, :3] = R_world_pelvis
-        q = self.configuration(q_cols_rad, T)
+        d = self._kinematics_at(q_cols_rad, R_world_pelvis)
         fid = self._frame_id[self.chains[limb].frame]
-        J = pin.computeFrameJacobian(self.model, self.data, q, fid,
-                                     pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+        J = pin.getFrameJacobian(self.model, d, fid, pin.LOCAL_WORLD_ALIGNED)
         jt = J[:3].T @ np.asarray(force_world_n, dtype=float)
         out = np.zeros(len(JOINT_NAMES))
         out[self._have] = jt[self._v_cols]
@@ -119,15 +139,10 @@ class MotionRobotModel:
         and a leg joint's torque is ``g − Jᵀw`` over its foot's wrench: ∂τ/∂f = a + b × r,
         with (a, b) the joint's column of the sole's Jacobian.
         """
-        T = np.eye(4)
-        T[:3, :3] = R_world_pelvis
-        q = self.configuration(q_cols_rad, T)
-        m, d = self.model, self.data
-        pin.computeJointJacobians(m, d, q)
-        pin.updateFramePlacements(m, d)
+        d = self._kinematics_at(q_cols_rad, R_world_pelvis)
         sole = self._frame_id[self.chains[foot].frame]
         palm = self._frame_id[self.chains[hand].frame]
-        jacobian = pin.getFrameJacobian(m, d, sole, pin.LOCAL_WORLD_ALIGNED)
+        jacobian = pin.getFrameJacobian(self.model, d, sole, pin.LOCAL_WORLD_ALIGNED)
         column = jacobian[:, self._v_of_col[joint_col]]
         r = d.oMf[palm].translation - d.oMf[sole].translation
         return column[:3] + np.cross(column[3:], r)

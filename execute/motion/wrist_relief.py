@@ -3,7 +3,8 @@ comply (it shares a 3-channel board with the fingers, hubo-facts §2).
 
 With the hand closed on its rail, a twist of the grip loads its position loop; when its
 board trips, the fingers let go. The motor current says how hard a joint pushes (``τ =
-η·gear·Kt·I``, `robot.motors`). While that torque is above ``relief_fraction`` of the
+η·gear·Kt·I``, `robot.motors.MotorTable.torque_nm`, which the motion layer applies once a
+tick to every column). While that torque is above ``relief_fraction`` of the
 joint's limit, its reference walks towards where the grip wants it, at
 ``relief_speed_rad_s``, within ``max_offset_rad``; the offset is kept while the hand
 holds and unwound while it moves in the air.
@@ -17,7 +18,6 @@ import numpy as np
 
 from robot.joints import JOINT_INDEX
 from robot.limits import joint_limits
-from robot.motors import MotorTable, motor_table
 
 __all__ = ["WRIST_ROLL", "WristRelief"]
 
@@ -25,7 +25,7 @@ WRIST_ROLL = {"left": JOINT_INDEX["LWR"], "right": JOINT_INDEX["RWR"]}
 
 
 class WristRelief:
-    """Offsets of rigid joints from their sensed motor currents (module docstring).
+    """Offsets of rigid joints from their sensed torques (module docstring).
 
     Args:
         robot: robot name (torque limits).
@@ -35,21 +35,20 @@ class WristRelief:
     """
 
     def __init__(self, robot: str = "drc-hubo", relief_fraction: float = 0.5,
-                 relief_speed_rad_s: float = 0.3, max_offset_rad: float = 0.6,
-                 motors: MotorTable | None = None):
+                 relief_speed_rad_s: float = 0.3, max_offset_rad: float = 0.6):
         self.limit_nm = joint_limits(robot).torque_max_nm
-        self.motors = motors or motor_table()
         self.relief_fraction = relief_fraction
         self.speed = relief_speed_rad_s
         self.max_offset_rad = max_offset_rad
         self.offset_rad: dict[int, float] = {}
 
-    def update(self, joint: int, holding: bool, cur_a: np.ndarray, dt_s: float) -> float:
-        """The offset of column ``joint`` after one tick [rad]."""
+    def update(self, joint: int, holding: bool, torque_nm: np.ndarray, dt_s: float) -> float:
+        """The offset of column ``joint`` after one tick [rad]; ``torque_nm``: the sensed
+        joint torques by column [N·m]."""
         j = joint
         off = self.offset_rad.get(j, 0.0)
         if holding:
-            torque = float(self.motors.torque_nm(cur_a)[j])
+            torque = float(torque_nm[j])
             if abs(torque) > self.relief_fraction * self.limit_nm[j]:
                 # the loop pushes with +τ towards a reference above the joint: give way
                 off -= math.copysign(self.speed * dt_s, torque)
