@@ -24,7 +24,7 @@ import numpy as np
 from robot.joints import FINGER_JOINTS, joint_indices
 from robot.kinematic_tree import FINGER_CLOSED_RAD, finger_contact_curl_rad
 
-__all__ = ["GraspReading", "read_grasp"]
+__all__ = ["GraspReading", "closed_around_rail", "read_grasp"]
 
 _FINGER_COLS = {side: joint_indices(FINGER_JOINTS[side]) for side in FINGER_JOINTS}
 ON_RAIL_FRACTION = 0.5  #: below this share of closed, a still hand holds something
@@ -52,3 +52,12 @@ def read_grasp(side: str, pos_rad: np.ndarray, vel_rad_s: np.ndarray,
     if on_rail <= curl < ON_RAIL_FRACTION * FINGER_CLOSED_RAD and speed < STILL_RAD_S:
         return GraspReading.ON_RAIL
     return GraspReading.CLOSING
+
+
+def closed_around_rail(side: str, pos_rad: np.ndarray, rail_radius_m: float) -> bool:
+    """Whether one hand's fingers still stand closed at least as far as a rail of radius
+    ``rail_radius_m`` [m] stops them, and short of closed on nothing, moving or not: the
+    grip still holds (or is just closing on, or opening from) its rail."""
+    curl = float(np.mean(pos_rad[_FINGER_COLS[side]]))
+    on_rail = finger_contact_curl_rad(rail_radius_m) - CONTACT_SLACK_RAD
+    return on_rail <= curl < EMPTY_FRACTION * FINGER_CLOSED_RAD

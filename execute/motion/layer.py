@@ -52,7 +52,7 @@ from execute.motion.config import MotionConfig
 from execute.motion.estimator import BodyEstimate, StateEstimator
 from execute.motion.events import MotionEvent, MotionEventKind, MotionStop
 from execute.motion.gains import motion_pwm_gains
-from execute.motion.grasp_check import GraspReading, read_grasp
+from execute.motion.grasp_check import GraspReading, closed_around_rail, read_grasp
 from execute.motion.gravity_compensation import ArmGravityCompensation
 from execute.motion.ladder_estimate import LadderEstimate, RailObservation
 from execute.motion.leg_relief import LegRelief
@@ -571,8 +571,12 @@ class MotionLayer:
                         and bool(tick.comply[cols].all()))
             if gripping and side not in self._stiff_arms:
                 lifting.append(side)
+            # the wrist roll gives way while the fingers say the hand holds its rail, in
+            # either arm mode and through a release until the fingers have let go: a
+            # grip twisted against the rail loads it whatever the plan's phase
             wrist_roll = WRIST_ROLL[side]
-            ref[wrist_roll] += self.wrist_relief.update(wrist_roll, gripping,
+            holding = closed_around_rail(side, s.pos_rad, self.geometry.spec.rail_radius_m)
+            ref[wrist_roll] += self.wrist_relief.update(wrist_roll, holding,
                                                         self._sensed_torque_nm, dt)
             share = self.config.holding_arm_stiffness
             if gripping and share < 1.0:
