@@ -91,6 +91,20 @@ def test_the_estimator_runs_on_the_state_struct_alone():
         SensedState.from_sample(np.zeros(3))
 
 
+def test_a_hand_counts_as_holding_while_its_fingers_stand_around_the_rail():
+    """The wrist roll's relief follows the fingers, not the plan's phase: a hand still
+    closed on its rail holds it while it starts to open, and one closed on nothing or
+    open does not."""
+    from execute.motion.grasp_check import closed_around_rail
+
+    pos = np.zeros(NUM_JOINTS)
+    fingers = [JOINT_INDEX[f] for f in FINGER_JOINTS["right"]]
+    for curl, holds in ((0.09, True), (0.07, True), (0.0, False), (FINGER_CLOSED_RAD, False)):
+        pos[fingers] = curl
+        assert closed_around_rail("right", pos, 0.025) is holds, curl
+    assert not closed_around_rail("left", pos, 0.025)
+
+
 def test_the_ladder_estimate_recovers_shift_and_yaw():
     est = LadderEstimate(max_shift_m=0.1, max_yaw_rad=0.3)
     up = np.array([0.5, 0.0, np.sqrt(3) / 2])

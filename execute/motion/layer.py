@@ -21,8 +21,8 @@ hubo-motion-rt and the thesis's operator did (thesis §4.3.4, §6.2):
   the layer **stops**: the player stays paused, every verified grip is kept, and the
   climb ends with the reason. The weight never moves onto an unverified grasp;
 - **a guard on stiff arms**: a stiff arm that pushes near a torque limit complies again;
-- **wrist-roll relief** of a gripping compliant arm (`execute.motion.wrist_relief`), from
-  its motor current;
+- **wrist-roll relief** of a gripping arm (`execute.motion.wrist_relief`), from its motor
+  current, while its fingers hold the rail;
 - **leg relief** (`execute.motion.leg_relief`): while a stance leg's joint pushes near its
   torque limit (motor current), the gripping compliant arms lift more of the body;
 - **reach correction**: every verified grasp measures where its rail is
