@@ -18,6 +18,7 @@ diameter can.
 from __future__ import annotations
 
 import enum
+import functools
 
 import numpy as np
 
@@ -39,17 +40,28 @@ class GraspReading(enum.Enum):
     CLOSING = "closing"
 
 
+@functools.lru_cache(maxsize=8)
+def _rail_stop_curl_rad(rail_radius_m: float) -> float:
+    """The least mean curl that reads as fingers stopped by a rail of this radius [rad]:
+    its contact curl less ``CONTACT_SLACK_RAD`` (one ladder's radius; asked every tick)."""
+    return finger_contact_curl_rad(rail_radius_m) - CONTACT_SLACK_RAD
+
+
+def _curl_rad(side: str, pos_rad: np.ndarray) -> float:
+    """One hand's mean finger encoder [rad]."""
+    return float(np.mean(pos_rad[_FINGER_COLS[side]]))
+
+
 def read_grasp(side: str, pos_rad: np.ndarray, vel_rad_s: np.ndarray,
                rail_radius_m: float) -> GraspReading:
     """What the finger encoders of one hand, commanded closed on a rail of radius
     ``rail_radius_m`` [m], say (module docstring)."""
-    cols = _FINGER_COLS[side]
-    curl = float(np.mean(pos_rad[cols]))
-    speed = float(np.mean(np.abs(vel_rad_s[cols])))
+    curl = _curl_rad(side, pos_rad)
     if curl >= EMPTY_FRACTION * FINGER_CLOSED_RAD:
         return GraspReading.EMPTY
-    on_rail = finger_contact_curl_rad(rail_radius_m) - CONTACT_SLACK_RAD
-    if on_rail <= curl < ON_RAIL_FRACTION * FINGER_CLOSED_RAD and speed < STILL_RAD_S:
+    speed = float(np.mean(np.abs(vel_rad_s[_FINGER_COLS[side]])))
+    if _rail_stop_curl_rad(rail_radius_m) <= curl < ON_RAIL_FRACTION * FINGER_CLOSED_RAD \
+            and speed < STILL_RAD_S:
         return GraspReading.ON_RAIL
     return GraspReading.CLOSING
 
@@ -58,6 +70,5 @@ def closed_around_rail(side: str, pos_rad: np.ndarray, rail_radius_m: float) -> 
     """Whether one hand's fingers still stand closed at least as far as a rail of radius
     ``rail_radius_m`` [m] stops them, and short of closed on nothing, moving or not: the
     grip still holds (or is just closing on, or opening from) its rail."""
-    curl = float(np.mean(pos_rad[_FINGER_COLS[side]]))
-    on_rail = finger_contact_curl_rad(rail_radius_m) - CONTACT_SLACK_RAD
-    return on_rail <= curl < EMPTY_FRACTION * FINGER_CLOSED_RAD
+    curl = _curl_rad(side, pos_rad)
+    return _rail_stop_curl_rad(rail_radius_m) <= curl < EMPTY_FRACTION * FINGER_CLOSED_RAD

@@ -532,9 +532,10 @@ class MotionLayer:
         self._now = now_s
         s = SensedState.from_sample(state_sample)
         self.estimate = self.estimator.update(s)
+        dt = 0.0 if self._last_now is None else now_s - self._last_now
+        self._last_now = now_s
         self._sensed_torque_nm = self.motors.torque_nm(s.cur_a)
-        self._guard_stiff_arms(self._sensed_torque_nm,
-                               0.0 if self._last_now is None else now_s - self._last_now)
+        self._guard_stiff_arms(self._sensed_torque_nm, dt)
         if self._regrasp is not None:
             self._update_regrasp(s)
         tick = self.player.step(now_s, s.pos_rad)
@@ -548,9 +549,11 @@ class MotionLayer:
             if due is not None:
                 self._regrasp = due
                 self.player.pause(now_s)
-        return self._command(tick, s)
+        return self._command(tick, s, dt)
 
-    def _command(self, tick: PlayerTick, s: SensedState) -> PlayerTick:
+    def _command(self, tick: PlayerTick, s: SensedState, dt: float) -> PlayerTick:
+        """The tick's references, modes and feed-forward; ``dt``: time since the last
+        tick [s]."""
         plan_rad = tick.ref_rad
         ref = plan_rad.copy()
         for blend in self._offsets.values():
@@ -561,8 +564,6 @@ class MotionLayer:
         self._last_ref = ref
         mode = tick.mode
         seg = self.sidecar.segments[int(self._segment_of_line[tick.line_index])]
-        dt = 0.0 if self._last_now is None else self._now - self._last_now
-        self._last_now = self._now
         lifting: list[str] = []  # compliant arms gripping a rail
         for side in SIDES:
             hold = seg.holds.get(f"{side}_hand")
