@@ -63,15 +63,16 @@ class FieldRule:
         return f"{kind}[{self.low:g}, {self.high:g}]{unit}"
 
 
-#: The one table of allowed ranges. Bounds are physical: 30° is the shallowest thing
-#: still called a ladder (a stair below), rung spacing 0.1–0.5 m brackets what a human or
-#: Hubo leg can step, rails further apart than 2 m are out of a Hubo's reach.
+#: The one table of allowed ranges. Bounds are what a ladder can physically be (30° is the
+#: shallowest thing still called a ladder, a stair below it), not what a robot can climb:
+#: whether this robot reaches a ladder's rungs and rails is the planner's pre-check's
+#: question (`planner.reachability`).
 FIELD_RULES: dict[str, FieldRule] = {
     "name": FieldRule("str", doc="ladder name (used for output file names)"),
     "slope_deg": FieldRule("float", 30.0, 90.0, "deg", doc="inclination from the floor"),
     "num_rungs": FieldRule("int", 1, 30, doc="number of rungs"),
-    "rung_spacing_m": FieldRule("float", 0.10, 0.50, "m", doc="vertical distance between rungs"),
-    "first_rung_height_m": FieldRule("float", 0.05, 0.60, "m",
+    "rung_spacing_m": FieldRule("float", 0.10, 1.00, "m", doc="vertical distance between rungs"),
+    "first_rung_height_m": FieldRule("float", 0.05, 1.00, "m",
                                      doc="top of the first rung above the floor"),
     "rung_width_m": FieldRule("float", 0.20, 2.00, "m", doc="rung length along y_L"),
     "rung_depth_m": FieldRule("float", 0.01, 0.40, "m",
@@ -79,7 +80,7 @@ FIELD_RULES: dict[str, FieldRule] = {
     "rung_thickness_m": FieldRule("float", 0.005, 0.10, "m",
                                   doc="vertical thickness (box rungs only)"),
     "rung_shape": FieldRule("str", choices=RUNG_SHAPES, doc="rung cross-section"),
-    "rail_spacing_m": FieldRule("float", 0.30, 2.00, "m", doc="distance between rail axes"),
+    "rail_spacing_m": FieldRule("float", 0.30, 3.00, "m", doc="distance between rail axes"),
     "rail_height_m": FieldRule("float", 0.30, 1.50, "m",
                                doc="rail axis height above the rung line"),
     "rail_radius_m": FieldRule("float", 0.005, 0.08, "m", doc="handrail radius"),

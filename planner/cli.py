@@ -10,11 +10,13 @@ LADDER is a bundled ladder (``drc``, ``ship``, ``stair``) or a spec file. A prog
 bar follows the primitives and rungs; a table summarises each primitive at the end.
 The same seed gives the same trajectory file, byte for byte.
 
-Exit codes: 0 a plan was written; 1 no plan (``no plan: <primitive> at rung <k> (<what
-it does>): <why the search stopped>``, then that step's failed samples grouped by
-reason, in cm, degrees and torque ratios; ``-v`` adds the solver's figures), or it could
-not be timed within the joint limits; 2 bad input (the message names the file, field or
-option).
+Exit codes: 0 a plan was written; 1 no plan: the ladder is out of the robot's reach
+(``no plan: ladder '<name>' is out of the <robot>'s reach: <what, by how much>``, the
+pre-check of `planner.reachability`, in well under a second), or the search stopped
+(``no plan: <primitive> at rung <k> (<what it does>): <why the search stopped>``, then
+that step's failed samples grouped by reason, in cm, degrees and torque ratios; ``-v``
+adds the solver's figures), or the plan could not be timed within the joint limits;
+2 bad input (the message names the file, field or option).
 """
 
 from __future__ import annotations
@@ -166,6 +168,7 @@ def _no_plan_message(exc, planner, spec, current, time_limit_s: float) -> str:
 def _plan(args: argparse.Namespace, err) -> int:
     from ladders.loader import load_ladder
     from planner.output import write_plan
+    from planner.reachability import LadderOutOfReach, check_reach
     from planner.search import ClimbPlanner, PlannerConfig, PlanningFailed
     from planner.time_limit import HARD_LIMIT_GRACE_S, TimeLimitExceeded, hard_time_limit
     from primitives.library import climb_sequence
@@ -174,6 +177,11 @@ def _plan(args: argparse.Namespace, err) -> int:
 
     t0 = time.perf_counter()
     spec = load_ladder(args.ladder)
+    try:  # before the planner's models load: a ladder out of reach is refused at once
+        check_reach(spec, args.robot)
+    except LadderOutOfReach as exc:
+        err.print(f"no plan: {exc}", markup=False, highlight=False, soft_wrap=True)
+        return 1
     config = PlannerConfig(samples_per_step=args.samples, resolution_rad=args.resolution,
                            time_limit_s=args.time_limit, arm_strategy=args.arm_strategy,
                            max_torque_ratio=args.max_torque_ratio,

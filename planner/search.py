@@ -37,6 +37,7 @@ from planner.paths.interpolation import (
 )
 from planner.paths.limb_path import foot_waypoints, hand_waypoints
 from planner.paths.limb_rrt import plan_limb_path
+from planner.reachability import check_reach
 from planner.statics.arm_capacity import DEFAULT_ARM_STRATEGY, DEFAULT_POSITION_TORQUE_SHARE
 from primitives.hold_seeds import FloorSeed, RailSeed
 from primitives.library import climb_sequence
@@ -262,6 +263,7 @@ class ClimbPlanner:
         from ladders.collision import ladder_collision_objects
 
         self.spec = spec
+        self.robot = robot
         self.geom = LadderGeometry(spec)
         self.kin = HuboKinematics.load(robot)
         self.collision = CollisionModel(self.kin, ladder_collision_objects(spec),
@@ -676,7 +678,10 @@ class ClimbPlanner:
     def plan(self, top_rung: int | None = None,
              progress: Callable[[int, int, Step, StepStats], None] | None = None
              ) -> SearchResult:
-        """Search the whole climb; raises `PlanningFailed` when the time or samples run out."""
+        """Search the whole climb; raises `LadderOutOfReach` when the pre-check rules the
+        ladder out (`planner.reachability`), `PlanningFailed` when the time or samples run
+        out."""
+        check_reach(self.spec, self.robot)
         t_start = time.perf_counter()
         top = self.top_rung() if top_rung is None else top_rung
         if not 0 <= top < self.spec.num_rungs:
