@@ -23,13 +23,19 @@ def parameter_rows(spec: LadderSpec) -> list[tuple[str, str, str, str]]:
     for f in fields(spec):
         rule = FIELD_RULES[f.name]
         value = getattr(spec, f.name)
-        shown = f"{value:g}" if isinstance(value, float) else str(value)
+        if value is None:  # a part the ladder does not have (its landing)
+            shown = "none"
+        elif isinstance(value, bool):
+            shown = str(value).lower()
+        else:
+            shown = f"{value:g}" if isinstance(value, float) else str(value)
         rows.append((f.name, shown, rule.unit, f"{rule.doc}; allowed {rule.describe()}"))
     return rows
 
 
 def side_view_png(spec: LadderSpec, path: Path) -> Path:
-    """Side view (world x–z) of rungs, rails and stringers, with the start sole, as PNG."""
+    """Side view (world x–z) of rungs, rails, stringers and the landing, with the start
+    sole, as PNG."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -38,7 +44,8 @@ def side_view_png(spec: LadderSpec, path: Path) -> Path:
 
     geom = LadderGeometry(spec)
     fig, ax = plt.subplots(figsize=(6, 7))
-    for solid in geom.stringers + geom.rungs:
+    slabs = tuple(s for s in geom.landing if s.kind == "box")
+    for solid in geom.stringers + geom.rungs + slabs:
         h = solid.half_extents_m
         if solid.kind == "cylinder" and solid.name.startswith("rung"):
             centre = solid.centre_m
@@ -46,11 +53,18 @@ def side_view_png(spec: LadderSpec, path: Path) -> Path:
             continue
         corners = [[sx * h[0], 0.0, sz * h[2]] for sx, sz in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
         pts = [solid.T_world_solid[:3, :3] @ c + solid.centre_m for c in corners]
-        color = "tab:orange" if solid.name.startswith("rung") else "0.8"
+        color = ("tab:orange" if solid.name.startswith("rung") else
+                 "tab:brown" if solid.name == "landing" else "0.8")
         ax.add_patch(Polygon([(p[0], p[2]) for p in pts], closed=True, color=color,
-                             zorder=2 if color == "tab:orange" else 1))
+                             zorder=1 if color == "0.8" else 2,
+                             label="top landing" if solid.name == "landing" else None))
     p0, p1 = geom.rail_axis("left")
     ax.plot([p0[0], p1[0]], [p0[2], p1[2]], color="0.4", lw=3, label="handrail axis")
+    for solid in geom.landing:
+        if solid.kind == "cylinder":  # a handrail over the landing, axis along local z
+            ends = [solid.centre_m + sign * solid.half_extents_m[2] * solid.R_world_solid[:, 2]
+                    for sign in (-1, 1)]
+            ax.plot([e[0] for e in ends], [e[2] for e in ends], color="0.4", lw=3)
     ax.plot([-0.11, 0.11], [0.0, 0.0], color="tab:blue", lw=4, label="robot's sole at start")
     ax.axhline(0.0, color="k", lw=0.8)
     ax.set_aspect("equal")

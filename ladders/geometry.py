@@ -1,4 +1,5 @@
-"""Ladder geometry in the world frame: rungs, handrails and stringers as primitive solids.
+"""Ladder geometry in the world frame: rungs, rails, stringers and the top landing (with
+its handrails) as primitive solids.
 
 `LadderGeometry` is the one place where a `LadderSpec` turns into positions. The mesh
 (trimesh), the collision objects (coal) and the MJCF body all read its `solids`, so
@@ -15,7 +16,7 @@ from typing import Literal
 
 import numpy as np
 
-from ladders.spec import STRINGER_DEPTH_M, STRINGER_WIDTH_M, LadderSpec
+from ladders.spec import LANDING_THICKNESS_M, STRINGER_DEPTH_M, STRINGER_WIDTH_M, LadderSpec
 from robot.errors import InputError
 from robot.vocabulary import SIDES
 
@@ -201,8 +202,10 @@ class LadderGeometry:
     @cached_property
     def _rail_axes(self) -> dict[str, tuple[np.ndarray, np.ndarray]]:
         s = self.spec
-        # From above the rung line's floor point to above a virtual rung N.
-        end_L = np.array([s.rung_run_m(s.num_rungs), 0.0, s.rung_height_m(s.num_rungs)])
+        # From above the rung line's floor point to above a virtual rung N, or to above
+        # where the rung line reaches the landing's top.
+        end_L = self._rung_line_point_L(self.landing_top_height_m if s.has_landing
+                                        else s.rung_height_m(s.num_rungs))
         out = {}
         for side in SIDES:
             offset_L = np.array([0.0, _SIDE_SIGN[side] * s.rail_spacing_m / 2, s.rail_height_m])
@@ -212,7 +215,8 @@ class LadderGeometry:
     def rail_axis(self, side: str) -> tuple[np.ndarray, np.ndarray]:
         """End points (p0 bottom, p1 top) of a rail's axis in the world frame [m].
 
-        The rail runs from x_L = 0 to one rung spacing beyond the top rung, its axis
+        The rail runs from x_L = 0 to one rung spacing beyond the top rung (with a
+        landing: to where the rung line reaches the landing's top), its axis
         ``rail_height_m`` vertically above the rung line.
 
         Args:
@@ -287,11 +291,53 @@ class LadderGeometry:
                              half.copy()))
         return tuple(out)
 
+    # --- landing ------------------------------------------------------------------
+    def _rung_line_point_L(self, height_m: float) -> np.ndarray:
+        """The rung line's point at ``height_m`` above the floor, in L [m]."""
+        return np.array([height_m / math.tan(self.spec.slope_rad), 0.0, height_m])
+
+    @property
+    def landing_top_height_m(self) -> float:
+        """Height of the landing's top surface above the floor [m] (a ladder with one)."""
+        return self.spec.top_rung_height_m + self.spec.landing_height_m
+
+    @cached_property
+    def landing(self) -> tuple[Solid, ...]:
+        """The top landing (``landing``, a horizontal slab `LANDING_THICKNESS_M` thick)
+        and, if the rails go on over it, its handrails (``handrail_left``,
+        ``handrail_right``, horizontal cylinders along x_L at the rails' height above
+        it); empty without a landing. The landing's front edge stands half a tread in
+        front of where the rung line reaches its top, as the next tread would."""
+        s = self.spec
+        if not s.has_landing:
+            return ()
+        top = self.landing_top_height_m
+        front_x = self._rung_line_point_L(top)[0] - s.rung_depth_m / 2
+        back_x = front_x + s.landing_depth_m
+        half = np.array([s.landing_depth_m / 2, s.landing_width_m / 2,
+                         LANDING_THICKNESS_M / 2])
+        centre_L = np.array([(front_x + back_x) / 2, 0.0, top - LANDING_THICKNESS_M / 2])
+        out = [Solid("landing", "box", make_transform(self.R_world_ladder,
+                                                      self.to_world(centre_L)), half)]
+        if s.landing_handrails:
+            R = self.R_world_ladder @ _rot_y(math.pi / 2)  # local z along x_L
+            start_x = self._rung_line_point_L(top)[0]
+            r = s.rail_radius_m
+            for side in SIDES:
+                centre_L = np.array([(start_x + back_x) / 2,
+                                     _SIDE_SIGN[side] * s.rail_spacing_m / 2,
+                                     top + s.rail_height_m])
+                out.append(Solid(f"handrail_{side}", "cylinder",
+                                 make_transform(R, self.to_world(centre_L)),
+                                 np.array([r, r, (back_x - start_x) / 2])))
+        return tuple(out)
+
     # --- everything ---------------------------------------------------------------
     @property
     def solids(self) -> tuple[Solid, ...]:
-        """All pieces: rungs, rails, stringers (in that order)."""
-        return self.rungs + self.rails + self.stringers
+        """All pieces: rungs, rails, stringers, the landing and its handrails (in that
+        order)."""
+        return self.rungs + self.rails + self.stringers + self.landing
 
     def bounds_m(self) -> np.ndarray:
         """Axis-aligned bounds of all solids in the world frame [m], shape (2, 3)."""

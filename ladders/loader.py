@@ -1,6 +1,6 @@
 """Ladder spec files (YAML): load with file/line error messages, dump, bundled ladders.
 
-A spec file has a top-level ``name`` and four sections; units are in the key names::
+A spec file has a top-level ``name`` and up to five sections; units are in the key names::
 
     name: drc
     geometry:
@@ -22,6 +22,11 @@ A spec file has a top-level ``name`` and four sections; units are in the key nam
       x_m: 0.16
       y_m: 0.0
       yaw_rad: 0.0
+    landing:                   # optional section: a platform above the top rung
+      height_m: 0.305          # its top above the top rung's top
+      depth_m: 1.2             # along the ladder's x, from its front edge
+      width_m: 1.2
+      handrails: true          # the rails go on over it
 
 Every problem is reported as ``FILE:LINE: field 'geometry.slope_deg' ...``.
 """
@@ -58,7 +63,12 @@ LAYOUT: dict[str | None, dict[str, str]] = {
     "contact": {"friction": "friction"},
     "placement": {"x_m": "placement_x_m", "y_m": "placement_y_m",
                   "yaw_rad": "placement_yaw_rad"},
+    "landing": {"height_m": "landing_height_m", "depth_m": "landing_depth_m",
+                "width_m": "landing_width_m", "handrails": "landing_handrails"},
 }
+#: Sections a ladder may leave out as a whole (a part it does not have); once given,
+#: each of their keys is required.
+_PART_SECTIONS = ("landing",)
 #: Fields with a default in `LadderSpec` may be left out of a file.
 _OPTIONAL_FIELDS = {f.name for f in fields(LadderSpec) if f.default is not MISSING}
 #: LadderSpec field -> dotted path in the file, for messages.
@@ -246,7 +256,8 @@ def _spec_from_layout(top: dict[str, tuple[Any, Any]], root: Any,
         for key, field in keys.items():
             path = FILE_KEYS[field]
             if key not in entries:
-                if field not in _OPTIONAL_FIELDS:
+                if field not in _OPTIONAL_FIELDS or (section in _PART_SECTIONS
+                                                     and section in top):
                     where = f"section '{section}'" if section else "the top level"
                     add(anchor, f"field '{path}' is missing from {where} "
                         f"(required, {FIELD_RULES[field].describe()})")
@@ -314,6 +325,8 @@ def ladder_to_mapping(spec: LadderSpec) -> dict[str, Any]:
     doc: dict[str, Any] = {}
     for section, keys in LAYOUT.items():
         entries = {key: getattr(spec, field) for key, field in keys.items()}
+        if section in _PART_SECTIONS and all(v is None for v in entries.values()):
+            continue
         if section is None:
             doc.update(entries)
         else:

@@ -16,7 +16,8 @@ ROLLING_FRICTION = 0.0001
 #: friction and condim for a rung or rail contact instead of the larger of the two).
 LADDER_CONTACT_PRIORITY = 1
 _RGBA = {"rung": [0.85, 0.55, 0.2, 1.0], "rail": [0.75, 0.75, 0.78, 1.0],
-         "stringer": [0.55, 0.45, 0.35, 1.0]}
+         "stringer": [0.55, 0.45, 0.35, 1.0], "landing": [0.6, 0.4, 0.25, 1.0],
+         "handrail": [0.75, 0.75, 0.78, 1.0]}
 
 
 def _quat(R: np.ndarray) -> list[float]:

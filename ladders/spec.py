@@ -27,6 +27,9 @@ from robot.errors import LadderSpecError
 #: Stringer (side rail holding the rungs) cross-section, fixed for every ladder [m].
 STRINGER_WIDTH_M = 0.03  # lateral, along y_L
 STRINGER_DEPTH_M = 0.12  # perpendicular to the rung line, in the x_L–z_L plane
+#: Thickness of a top landing's slab [m], fixed like the stringers: the planner and the
+#: simulator only meet its top surface and front edge.
+LANDING_THICKNESS_M = 0.05
 
 RUNG_SHAPES = ("box", "cylinder")
 _NAME_PATTERN = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]{0,63}")
@@ -37,12 +40,13 @@ class FieldRule:
     """The allowed values of one `LadderSpec` field.
 
     Attributes:
-        kind: ``"float"``, ``"int"`` or ``"str"``.
+        kind: ``"float"``, ``"int"``, ``"str"`` or ``"bool"``.
         low: Smallest allowed value (numbers only), inclusive.
         high: Largest allowed value (numbers only), inclusive.
         unit: Unit shown in messages and tables (``""`` for none).
         choices: Allowed strings (``rung_shape``), or empty.
         doc: One-line meaning, shown by ``python -m ladders show``.
+        optional: None is allowed (a part the ladder may not have: its landing).
     """
 
     kind: str
@@ -51,11 +55,14 @@ class FieldRule:
     unit: str = ""
     choices: tuple[str, ...] = ()
     doc: str = ""
+    optional: bool = False
 
     def describe(self) -> str:
         """The allowed range as text, e.g. ``[30, 90] deg``."""
         if self.choices:
             return "one of " + ", ".join(repr(c) for c in self.choices)
+        if self.kind == "bool":
+            return "true or false"
         if self.low is None:
             return "a name of 1-64 letters, digits, '_', '.', '-'"
         unit = f" {self.unit}" if self.unit else ""
@@ -89,7 +96,18 @@ FIELD_RULES: dict[str, FieldRule] = {
     "placement_y_m": FieldRule("float", -10.0, 10.0, "m", doc="ladder frame origin, world y"),
     "placement_yaw_rad": FieldRule("float", -math.pi, math.pi, "rad",
                                    doc="ladder frame yaw about world z"),
+    "landing_height_m": FieldRule("float", 0.05, 1.00, "m", optional=True,
+                                  doc="landing top above the top rung's top"),
+    "landing_depth_m": FieldRule("float", 0.30, 5.00, "m", optional=True,
+                                 doc="landing depth along x_L from its front edge"),
+    "landing_width_m": FieldRule("float", 0.30, 5.00, "m", optional=True,
+                                 doc="landing width along y_L, centred on the ladder"),
+    "landing_handrails": FieldRule("bool", optional=True,
+                                   doc="the rails go on over the landing as handrails"),
 }
+#: The landing's fields: a ladder has all of them or none.
+LANDING_FIELDS = ("landing_height_m", "landing_depth_m", "landing_width_m",
+                  "landing_handrails")
 
 
 class LadderFieldError(LadderSpecError):
@@ -121,6 +139,12 @@ def check_field(field: str, value: Any) -> Any:
     """
     rule = FIELD_RULES[field]
     allowed = rule.describe()
+    if value is None and rule.optional:
+        return None
+    if rule.kind == "bool":
+        if not isinstance(value, bool):
+            raise LadderFieldError((field,), f"= {value!r} is not {allowed}")
+        return value
     if rule.kind == "str":
         if not isinstance(value, str):
             raise LadderFieldError((field,), f"= {value!r} is a {type(value).__name__}, "
@@ -164,6 +188,12 @@ class LadderSpec:
         placement_x_m: World x of the ladder frame origin [m].
         placement_y_m: World y of the ladder frame origin [m].
         placement_yaw_rad: Yaw of the ladder frame about world z [rad].
+        landing_height_m: Height of the top landing's top surface above the top rung's
+            top [m], or None: no landing.
+        landing_depth_m: Landing depth along x_L, from its front edge [m] (or None).
+        landing_width_m: Landing width along y_L, centred on the ladder [m] (or None).
+        landing_handrails: Whether the rails go on over the landing as handrails (or
+            None without a landing).
     """
 
     name: str
@@ -182,6 +212,10 @@ class LadderSpec:
     placement_x_m: float = 0.0
     placement_y_m: float = 0.0
     placement_yaw_rad: float = 0.0
+    landing_height_m: float | None = None
+    landing_depth_m: float | None = None
+    landing_width_m: float | None = None
+    landing_handrails: bool | None = None
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -198,6 +232,11 @@ class LadderSpec:
     def top_rung_height_m(self) -> float:
         """Height of the top rung's top surface [m]."""
         return self.rung_height_m(self.num_rungs - 1)
+
+    @property
+    def has_landing(self) -> bool:
+        """Whether the ladder leads to a top landing."""
+        return self.landing_height_m is not None
 
     def rung_height_m(self, i: int) -> float:
         """Height h_i of rung ``i``'s top surface above the floor [m] (any integer i)."""
@@ -230,6 +269,7 @@ def check_cross_fields(spec: LadderSpec) -> None:
     - Rungs must not overlap each other (box: thickness < spacing; cylinder: diameter
       < centre distance ``spacing / sin(slope)``).
     - The first rung must stand on or above the floor.
+    - A landing has all of `LANDING_FIELDS` or none.
     - The rails must not pass through the rungs or stringers: either they clear the
       stringers' outer faces laterally by one rail radius, or their axes lie far enough
       above the rung line (``rail_height·cos(slope)``, perpendicular to it) to clear the
@@ -240,6 +280,13 @@ def check_cross_fields(spec: LadderSpec) -> None:
     Raises:
         LadderFieldError: naming the fields involved and their values.
     """
+    given = [f for f in LANDING_FIELDS if getattr(spec, f) is not None]
+    if given and len(given) < len(LANDING_FIELDS):
+        missing = [f for f in LANDING_FIELDS if f not in given]
+        raise LadderFieldError(
+            (missing[0], *given),
+            f"is missing: a landing needs {', '.join(LANDING_FIELDS)} (given: "
+            f"{', '.join(given)})")
     s = spec.slope_rad
     if spec.rung_shape == "box":
         if spec.rung_thickness_m >= spec.rung_spacing_m:
@@ -278,6 +325,6 @@ def check_cross_fields(spec: LadderSpec) -> None:
             f"(now {above_line_m:.3f} m at slope {spec.slope_deg:g} deg)")
 
 
-__all__ = ["FIELD_RULES", "RUNG_SHAPES", "STRINGER_DEPTH_M", "STRINGER_WIDTH_M", "FieldRule",
-           "LadderFieldError", "LadderSpec", "check_cross_fields", "check_field",
-           "rung_protrusion_m"]
+__all__ = ["FIELD_RULES", "LANDING_FIELDS", "LANDING_THICKNESS_M", "RUNG_SHAPES",
+           "STRINGER_DEPTH_M", "STRINGER_WIDTH_M", "FieldRule", "LadderFieldError",
+           "LadderSpec", "check_cross_fields", "check_field", "rung_protrusion_m"]
