@@ -2,14 +2,16 @@
 
 The torque LP (`planner.statics.torque_lp`) runs on every interpolated configuration;
 scipy's ``linprog`` wrapper costs more than HiGHS's solve of this small dense LP, so it
-passes the model to one reused HiGHS instance itself.
+passes the model's arrays to one reused HiGHS instance itself.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["dense_lp", "quiet_highs", "solve_lp"]
+from planner.statics.config import StabilityError
+
+__all__ = ["pass_dense_lp", "quiet_highs", "solve_lp"]
 
 _HIGHS = None
 
@@ -27,26 +29,34 @@ def quiet_highs():
     return _HIGHS
 
 
-def dense_lp(cost: np.ndarray, a: np.ndarray, row_lower: np.ndarray, row_upper: np.ndarray,
-             col_upper: np.ndarray):
-    """HiGHS's model of min cost·x s.t. row_lower ≤ a x ≤ row_upper, 0 ≤ x ≤ col_upper
-    (infinite bounds as numpy's inf), from a dense ``a``."""
+def pass_dense_lp(h, cost: np.ndarray, a: np.ndarray, row_lower: np.ndarray,
+                  row_upper: np.ndarray, col_upper: np.ndarray) -> None:
+    """Pass min cost·x s.t. row_lower ≤ a x ≤ row_upper, 0 ≤ x ≤ col_upper (infinite
+    bounds as numpy's inf), from a dense ``a``, to the HiGHS instance ``h``.
+
+    The arrays go straight to HiGHS's array overload of ``passModel``: building a
+    ``HighsLp`` attribute by attribute copied each array through pybind11 and cost about
+    six times as much (1.9 against 0.3 ms for an 80 × 130 model). The model is the same.
+
+    Raises:
+        StabilityError: HiGHS refused the model.
+    """
     import highspy
 
     inf = highspy.kHighsInf
-    lp = highspy.HighsLp()
-    lp.num_col_, lp.num_row_ = a.shape[1], a.shape[0]
-    lp.col_cost_ = cost
-    lp.col_lower_ = np.zeros(a.shape[1])
-    lp.col_upper_ = np.where(np.isinf(col_upper), inf, col_upper)
-    lp.row_lower_ = np.where(np.isinf(row_lower), -inf, row_lower)
-    lp.row_upper_ = np.where(np.isinf(row_upper), inf, row_upper)
-    lp.a_matrix_.format_ = highspy.MatrixFormat.kRowwise
+    n_row, n_col = a.shape
     rows, cols = np.nonzero(a)
-    lp.a_matrix_.start_ = np.concatenate([[0], np.cumsum(np.count_nonzero(a, axis=1))])
-    lp.a_matrix_.index_ = cols
-    lp.a_matrix_.value_ = a[rows, cols]
-    return lp
+    starts = np.zeros(n_row + 1, dtype=np.int32)
+    np.cumsum(np.count_nonzero(a, axis=1), out=starts[1:])
+    status = h.passModel(
+        n_col, n_row, len(cols), int(highspy.MatrixFormat.kRowwise),
+        int(highspy.ObjSense.kMinimize), 0.0, np.ascontiguousarray(cost, dtype=float),
+        np.zeros(n_col), np.where(np.isinf(col_upper), inf, col_upper),
+        np.where(np.isinf(row_lower), -inf, row_lower),
+        np.where(np.isinf(row_upper), inf, row_upper), starts, cols.astype(np.int32),
+        a[rows, cols], np.zeros(n_col, dtype=np.int32))  # integrality: all continuous
+    if status == highspy.HighsStatus.kError:  # a warning (tiny coefficients) still solves
+        raise StabilityError(f"HiGHS refused the LP ({n_row} × {n_col}): {status}")
 
 
 def solve_lp(cost: np.ndarray, a_ub: np.ndarray, b_ub: np.ndarray, a_eq: np.ndarray,
@@ -63,9 +73,9 @@ def solve_lp(cost: np.ndarray, a_ub: np.ndarray, b_ub: np.ndarray, a_eq: np.ndar
     import highspy
 
     h = quiet_highs()
-    h.passModel(dense_lp(cost, np.vstack([a_ub, a_eq]),
-                         np.concatenate([np.full(len(b_ub), -np.inf), b_eq]),
-                         np.concatenate([b_ub, b_eq]), upper))
+    pass_dense_lp(h, cost, np.vstack([a_ub, a_eq]),
+                  np.concatenate([np.full(len(b_ub), -np.inf), b_eq]),
+                  np.concatenate([b_ub, b_eq]), upper)
     h.run()
     status = h.getModelStatus()
     if status == highspy.HighsModelStatus.kOptimal:

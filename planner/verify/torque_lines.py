@@ -39,7 +39,7 @@ import numpy as np
 from ladders.contact_model import HandLimits
 from planner.statics.config import StabilityConfig, StabilityError, default_config
 from planner.statics.contact_wrenches import cone_edges_cached, grip_rows, split_wrench_basis
-from planner.statics.highs_lp import dense_lp, quiet_highs
+from planner.statics.highs_lp import pass_dense_lp, quiet_highs
 from planner.statics.torque_lp import GRIP_LOAD_COST, actuated_joints
 from planner.verify.batch_kinematics import BatchKinematics, JointPoses
 
@@ -371,7 +371,7 @@ class StanceLines:
         import highspy
 
         h = quiet_highs()
-        h.passModel(dense_lp(self.cost, A, lower, upper, self.upper))
+        pass_dense_lp(h, self.cost, A, lower, upper, self.upper)
         if self._basis is not None:
             h.setBasis(self._basis.highs)
         h.run()
