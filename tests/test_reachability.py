@@ -88,3 +88,9 @@ def test_the_planner_and_a_batch_job_refuse_it_too(tmp_path):
     out = plan_job(PlanJob(ladder_key="wide", ladder=wide, seed=1), str(tmp_path))
     assert out["outcome"] == "no_plan" and out["where"] == "reach"
     assert "rails 2.20 m apart" in out["why"]
+
+
+def test_the_hubo2plus_cannot_span_the_drc_ladder_s_rails():
+    (short,) = reach_shortfalls(load_ladder("drc"), "hubo2plus")
+    assert short.what == "rail_spacing_m" and short.reachable < 1.35
+    assert reach_shortfalls(load_ladder("ship"), "hubo2plus") == []
