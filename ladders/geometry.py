@@ -293,8 +293,11 @@ class LadderGeometry:
 
     # --- landing ------------------------------------------------------------------
     def _rung_line_point_L(self, height_m: float) -> np.ndarray:
-        """The rung line's point at ``height_m`` above the floor, in L [m]."""
-        return np.array([height_m / math.tan(self.spec.slope_rad), 0.0, height_m])
+        """The rung line's point at ``height_m`` above the floor, in L [m] (computed as
+        `LadderSpec.rung_run_m` does, so that the rails' ends are those of a ladder
+        without a landing to the last bit)."""
+        a = self.spec.slope_rad
+        return np.array([height_m * math.cos(a) / math.sin(a), 0.0, height_m])
 
     @property
     def landing_top_height_m(self) -> float:
