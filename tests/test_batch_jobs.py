@@ -20,7 +20,7 @@ sys.path.insert(0, str(Path(__file__).parent))
 import batch_small_jobs as small  # noqa: E402
 
 from execute.batch.engine import local_engine  # noqa: E402
-from execute.batch.jobs import JobFunctions, expand_jobs  # noqa: E402
+from execute.batch.jobs import JobFunctions, PlanJob, expand_jobs  # noqa: E402
 from execute.batch.perturb import Draw, PerturbSpec, draw, parse_perturb  # noqa: E402
 from execute.batch.results import ResultsLog  # noqa: E402
 from execute.batch.runner import RESULTS_FILE, run_batch  # noqa: E402
@@ -275,3 +275,22 @@ def test_no_plan_makes_failed_trials_without_simulating(tmp_path, engine):
             assert (r["outcome"], r["cause"]) == ("failed", "no_plan")
             assert r["why"].startswith("no plan: climbRung at rung 1")
     assert math.isfinite(run.wall_s)
+
+
+def test_a_ladder_without_a_landing_keeps_its_plan_fingerprint():
+    """Batches made before the spec had a landing still resume: absent parts are not
+    hashed; a landing is."""
+    import hashlib
+
+    stair = load_ladder("stair")
+    job = PlanJob(ladder_key="stair", ladder=stair, seed=3)
+    fields = {k: v for k, v in dataclasses.asdict(stair).items()
+              if not k.startswith("landing_")}
+    before = hashlib.sha256(json.dumps(
+        {"kind": "plan", "ladder": fields, "seed": 3, "robot": job.robot,
+         "time_limit_s": job.time_limit_s, "top_rung": None, "rate_hz": job.rate_hz},
+        sort_keys=True, default=str).encode()).hexdigest()[:16]
+    assert job.fingerprint == before
+    landed = dataclasses.replace(stair, landing_height_m=0.2, landing_depth_m=1.0,
+                                 landing_width_m=1.0, landing_handrails=False)
+    assert PlanJob(ladder_key="stair", ladder=landed, seed=3).fingerprint != before

@@ -82,8 +82,11 @@ class PlanJob:
 
     @property
     def fingerprint(self) -> str:
-        """Hash of every input: a record counts as this job's only if it matches."""
-        return _fingerprint({"kind": "plan", "ladder": dataclasses.asdict(self.ladder),
+        """Hash of every input: a record counts as this job's only if it matches. A part
+        the ladder does not have (its landing: None fields) is left out, so that a batch
+        made before the spec had that part still resumes."""
+        ladder = {k: v for k, v in dataclasses.asdict(self.ladder).items() if v is not None}
+        return _fingerprint({"kind": "plan", "ladder": ladder,
                              "seed": self.seed, "robot": self.robot,
                              "time_limit_s": self.time_limit_s, "top_rung": self.top_rung,
                              "rate_hz": self.rate_hz})
