@@ -166,6 +166,7 @@ class FailureCause(StrEnum):
     GRASP_LOST = "grasp_lost"
     FINAL_STANCE = "final_stance"
     GRASP_UNVERIFIED = "grasp_unverified"  # the motion layer stopped (`execute.motion`)
+    FOOTHOLD_UNVERIFIED = "foothold_unverified"  # it stopped: a foot found no rung
     NO_PLAN = "no_plan"  # batch-eval: the plan job found no plan, nothing was simulated
 
 

@@ -185,7 +185,9 @@ def test_a_missed_grasp_searches_where_the_holding_hands_found_the_rails(reach):
 
 @pytest.mark.parametrize("field,value", [("max_reach_correction_m", 0.2),
                                          ("grasp_retries", -1),
-                                         ("max_reach_correction_rad", 1.0)])
+                                         ("max_reach_correction_rad", 1.0),
+                                         ("landing_reach_m", 0.10),
+                                         ("landing_load_n", 0.0)])
 def test_unsafe_settings_are_refused(field, value):
     with pytest.raises(MotionConfigError) as exc:
         MotionConfig(**{field: value})

@@ -46,6 +46,10 @@ _RANGES = {
     "arrival_tolerance_m": (0.002, 0.05),
     "arrival_timeout_s": (0.0, 10.0),
     "hold_after_stop_s": (0.0, 30.0),
+    "landing_load_n": (5.0, 200.0),
+    "landing_wait_s": (0.0, 5.0),
+    "landing_reach_m": (0.0, 0.06),
+    "landing_speed_m_s": (0.002, 0.05),
 }
 
 
@@ -71,6 +75,13 @@ class MotionConfig:
         arrival_timeout_s: the longest wait for that [s].
         hold_after_stop_s: how long the pose is held after the layer stops, before the
             run ends (validation only) [s].
+        landing_load_n: foot F/T load that shows a foot standing on its rung at the end
+            of its step [N]; a foot in the air reads its own weight, about −12 N.
+        landing_wait_s: how long the player waits at the end of a step for that load
+            before the foot reaches further [s].
+        landing_reach_m: how far beyond its planned hold, down towards its rung, a foot
+            may reach to find it [m].
+        landing_speed_m_s: how fast it reaches [m/s].
         estimator: the state estimator's thresholds.
     """
 
@@ -87,6 +98,10 @@ class MotionConfig:
     arrival_tolerance_m: float = 0.01
     arrival_timeout_s: float = 4.0
     hold_after_stop_s: float = 2.0
+    landing_load_n: float = 20.0
+    landing_wait_s: float = 0.5
+    landing_reach_m: float = 0.03
+    landing_speed_m_s: float = 0.01
     estimator: EstimatorConfig = field(default_factory=EstimatorConfig)
 
     def __post_init__(self) -> None:

@@ -1,4 +1,5 @@
-"""What the motion layer did: one record per correction, grasp check, re-reach or stop."""
+"""What the motion layer did: one record per correction, grasp check, re-reach, foot
+landing or stop."""
 
 from __future__ import annotations
 
@@ -17,6 +18,7 @@ class MotionEventKind(enum.Enum):
     STIFF_REACH = "stiff reach"  #: a compliant arm short of its hold finished in position mode
     LEG_RELIEF = "leg relief"  #: the gripping arms began to lift more: a leg joint neared its limit
     LADDER_ESTIMATE = "ladder estimate"  #: the estimate of the ladder's pose changed
+    FOOT_LANDING = "foot landing"  #: a step ended with its foot unloaded; it reached further
     STOP = "stop"  #: the layer holds the pose and stops the climb
 
 

@@ -20,6 +20,11 @@ hubo-motion-rt and the thesis's operator did (thesis §4.3.4, §6.2):
   closes again, up to ``grasp_retries`` times. If it still holds nothing
   the layer **stops**: the player stays paused, every verified grip is kept, and the
   climb ends with the reason. The weight never moves onto an unverified grasp;
+- **guarded landing**: a step's foot must stand on its rung before the plan goes on (the
+  next step moves weight onto it). At the end of the step the player waits until the
+  foot's F/T sensor reads ``landing_load_n``; if it does not within ``landing_wait_s``, the
+  foot reaches further down towards its rung, at ``landing_speed_m_s``, until it does, at
+  most ``landing_reach_m``; then the layer **stops** as for a grasp;
 - **a guard on stiff arms**: a stiff arm that pushes near a torque limit complies again;
 - **wrist-roll relief** of a gripping arm (`execute.motion.wrist_relief`), from its motor
   current, while its fingers hold the rail;
@@ -123,6 +128,19 @@ class _Regrasp:
     candidates: list = dataclasses.field(default_factory=list)  # re-reach shifts [m]
 
 
+@dataclass
+class _Landing:
+    """A foot at the end of its step that its F/T sensor does not show standing yet,
+    while the player waits."""
+
+    side: str
+    segment: int
+    target: str  # the rung it steps onto
+    since_s: float
+    phase: str = "wait"  # "wait", then "reach" (down towards the rung)
+    reach_s: float = 0.0  # how long the full reach takes [s]
+
+
 class MotionLayer:
     """Closed-loop playback (module docstring).
 
@@ -174,6 +192,8 @@ class MotionLayer:
         self._arrived: set[tuple[int, str]] = set()
         self._last_ref = np.asarray(trajectory_rad[0], dtype=float).copy()
         self._regrasp: _Regrasp | None = None
+        self._landing: _Landing | None = None
+        self._landed: set[int] = set()  # segments whose foot has been seen standing
         self._open_fingers: set[str] = set()
         self._stiff_arms: set[str] = set()  # arms held in position mode until they grip
         self._yielded: set[str] = set()  # stiff arms that pushed on something, until they grip
@@ -526,6 +546,82 @@ class MotionLayer:
         self._event(MotionEventKind.STOP, f"{g.side}_hand", 0.0, reason)
         self._regrasp = None
 
+    # ------------------------------------------------------------------ landings
+    def _landing_due(self, line_index: int, s: SensedState) -> _Landing | None:
+        """A foot whose step onto a rung ends on this line and whose F/T sensor does not
+        show it standing yet."""
+        k = int(self._segment_of_line[line_index])
+        seg = self.sidecar.segments[k]
+        if seg.phase != "limb" or line_index < seg.last_line - 1 or k in self._landed:
+            return None
+        for limb, (_j, hold) in self._next_hold[k].items():
+            if limb.endswith("_foot") and self._on_ladder(hold.target):
+                self._landed.add(k)
+                side = _side(limb)
+                if s.foot_load_n(side) >= self.config.landing_load_n:
+                    return None
+                return _Landing(side, k, hold.target, self._now)
+        return None
+
+    def _update_landing(self, s: SensedState) -> None:
+        """Wait for the foot's load; then reach down towards its rung until it stands, or
+        stop once the reach is spent."""
+        f, cfg, now = self._landing, self.config, self._now
+        limb = f"{f.side}_foot"
+        load = s.foot_load_n(f.side)
+        elapsed = now - f.since_s
+        if load >= cfg.landing_load_n:
+            self._event(MotionEventKind.FOOT_LANDING, limb,
+                        self._landing_depth_m(f, elapsed),
+                        f"stands on {f.target} ({load:.0f} N) after {elapsed:.2f} s"
+                        + (" of reaching down" if f.phase == "reach" else " of waiting"))
+            self._freeze_offset(limb)
+            self._landing = None
+            self.player.resume(now)
+            return
+        if f.phase == "wait" and elapsed >= cfg.landing_wait_s:
+            if cfg.landing_reach_m <= 0.0:
+                self._stop_landing(f, load, 0.0)
+                return
+            # from where the step's own correction put the foot, straight down
+            down = self._shift_m.get(limb, np.zeros(3)) + [0.0, 0.0, -cfg.landing_reach_m]
+            dq, _residual = self._limb_shift_dq(limb, self._line, down)
+            current = self._offset(limb, float(self._line))
+            f.reach_s = cfg.landing_reach_m / cfg.landing_speed_m_s
+            self._offsets[limb] = _Blend(current if current is not None else np.zeros_like(dq),
+                                         dq, now, now + f.reach_s, time_based=True)
+            f.phase, f.since_s = "reach", now
+            self._event(MotionEventKind.FOOT_LANDING, limb, 0.0,
+                        f"the step ended with the foot's F/T at {load:.0f} N (standing: "
+                        f"{cfg.landing_load_n:.0f} N): it reaches down towards {f.target}, "
+                        f"at most {cfg.landing_reach_m * 100:.0f} cm")
+        elif f.phase == "reach" and elapsed >= f.reach_s:
+            self._stop_landing(f, load, cfg.landing_reach_m)
+
+    def _landing_depth_m(self, f: _Landing, elapsed_s: float) -> float:
+        """How far down a reaching foot has gone [m]."""
+        if f.phase != "reach" or f.reach_s <= 0.0:
+            return 0.0
+        return self.config.landing_reach_m * min(1.0, min_jerk(elapsed_s / f.reach_s))
+
+    def _freeze_offset(self, limb: str) -> None:
+        """A limb's offset stops where it is now (a reach found its hold mid-way) and is
+        kept while the limb holds."""
+        blend = self._offsets.get(limb)
+        if blend is None:
+            return
+        now = blend.at(self._now if blend.time_based else float(self._line))
+        self._offsets[limb] = _Blend(now, now, float(self._line), float(self._line))
+
+    def _stop_landing(self, f: _Landing, load_n: float, reached_m: float) -> None:
+        reason = (f"{f.side}_foot found no rung: its F/T read {load_n:.0f} N after reaching "
+                  f"{reached_m * 100:.0f} cm below its planned hold on {f.target}: the weight "
+                  "was not moved onto it")
+        self.stop = MotionStop(self._now, self._line + 1, f"{f.side}_foot", reason, 0,
+                               {"rung": f.target})
+        self._event(MotionEventKind.STOP, f"{f.side}_foot", reached_m, reason)
+        self._landing = None
+
     # ------------------------------------------------------------------ the tick
     def step(self, now_s: float, state_sample: np.ndarray) -> PlayerTick:
         """The command of the tick at ``now_s``, from the daemon's state sample."""
@@ -538,17 +634,24 @@ class MotionLayer:
         self._guard_stiff_arms(self._sensed_torque_nm, dt)
         if self._regrasp is not None:
             self._update_regrasp(s)
+        elif self._landing is not None:
+            self._update_landing(s)
         tick = self.player.step(now_s, s.pos_rad)
         self._line = tick.line_index
         k = int(self._segment_of_line[tick.line_index])
         if k != self._segment and not tick.going_to_init:
             self._segment = k
             self._enter_segment(k)
-        if self._regrasp is None and self.stop is None and not tick.going_to_init:
+        if self._regrasp is None and self._landing is None and self.stop is None \
+                and not tick.going_to_init:
             due = self._grasp_due(tick.line_index)
             if due is not None:
                 self._regrasp = due
                 self.player.pause(now_s)
+            else:
+                self._landing = self._landing_due(tick.line_index, s)
+                if self._landing is not None:
+                    self.player.pause(now_s)
         return self._command(tick, s, dt)
 
     def _command(self, tick: PlayerTick, s: SensedState, dt: float) -> PlayerTick:

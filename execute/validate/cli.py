@@ -112,6 +112,8 @@ NEXT_STEP = {
                                "the end",
     FailureCause.GRASP_UNVERIFIED: "the motion layer stopped (the JSON's motion section says "
                                    "why); --open-loop plays the file as the thesis did",
+    FailureCause.FOOTHOLD_UNVERIFIED: "a foot found no rung where the plan put it: check the "
+                                      "ladder's rung heights against its spec",
 }
 #: The longest cause line printed; the full text is the JSON's ``why``.
 CAUSE_CHARS = 160

@@ -307,11 +307,13 @@ def _run_ticks(board: BoardModel, player: TrajectoryPlayer, motion, controller: 
 
 def _final_verdict(failure: Failure | None, motion, monitor: VerdictMonitor, time_s: float,
                    line_index: int) -> Verdict:
-    """The run's verdict: its first failure; else a motion layer that stopped (a grasp it
-    could not verify); else the monitor's checks of the final stance."""
+    """The run's verdict: its first failure; else a motion layer that stopped (a grasp or
+    a foothold it could not verify); else the monitor's checks of the final stance."""
     if failure is None and motion is not None and motion.stop is not None:
         stop = motion.stop
-        failure = Failure(FailureCause.GRASP_UNVERIFIED, stop.time_s, stop.line,
+        cause = (FailureCause.FOOTHOLD_UNVERIFIED if stop.limb.endswith("_foot")
+                 else FailureCause.GRASP_UNVERIFIED)
+        failure = Failure(cause, stop.time_s, stop.line,
                           f"the motion layer held the pose and stopped: {stop.reason}",
                           {"limb": stop.limb, "tries": stop.tries, **stop.details})
     if failure is not None:
