@@ -193,7 +193,7 @@ class MotionLayer:
         self._last_ref = np.asarray(trajectory_rad[0], dtype=float).copy()
         self._regrasp: _Regrasp | None = None
         self._landing: _Landing | None = None
-        self._landed: set[int] = set()  # segments whose foot has been seen standing
+        self._landed: set[int] = set()  # steps whose foot landing has been checked
         self._open_fingers: set[str] = set()
         self._stiff_arms: set[str] = set()  # arms held in position mode until they grip
         self._yielded: set[str] = set()  # stiff arms that pushed on something, until they grip
@@ -602,7 +602,7 @@ class MotionLayer:
         """How far down a reaching foot has gone [m]."""
         if f.phase != "reach" or f.reach_s <= 0.0:
             return 0.0
-        return self.config.landing_reach_m * min(1.0, min_jerk(elapsed_s / f.reach_s))
+        return self.config.landing_reach_m * min_jerk(elapsed_s / f.reach_s)
 
     def _freeze_offset(self, limb: str) -> None:
         """A limb's offset stops where it is now (a reach found its hold mid-way) and is
