@@ -41,8 +41,6 @@ from robot.params import RobotParams, robot_params
 __all__ = ["LadderOutOfReach", "ReachShortfall", "check_reach", "reach_shortfalls",
            "step_height_reach_m"]
 
-#: Robot names as users know them.
-ROBOT_TITLES = {"drc-hubo": "DRC-Hubo", "hubo2plus": "Hubo2+"}
 #: Grid of the step-height search: samples of the pelvis pitch, hip pitch and knee.
 _PITCH_SAMPLES, _HIP_SAMPLES, _KNEE_SAMPLES = 37, 91, 79
 #: Bin width of the soles' horizontal offsets in the step-height search [m].
@@ -71,7 +69,7 @@ class LadderOutOfReach(HuboLadderError):
 
     def __init__(self, robot: str, ladder: str, shortfalls: list[ReachShortfall]):
         self.shortfalls = shortfalls
-        title = ROBOT_TITLES.get(robot, robot)
+        title = robot_params(robot).title or robot
         super().__init__(f"ladder '{ladder}' is out of the {title}'s reach: "
                          + "; ".join(s.message for s in shortfalls))
 
@@ -128,7 +126,7 @@ def reach_shortfalls(spec: LadderSpec, robot: str = "drc-hubo") -> list[ReachSho
     """What this robot cannot reach on this ladder (module docstring); empty if nothing
     rules the climb out."""
     p = robot_params(robot)
-    title = ROBOT_TITLES.get(robot, robot)
+    title = p.title or robot
     out: list[ReachShortfall] = []
 
     mount = step_height_reach_m(robot)

@@ -41,6 +41,8 @@ class RobotParams:
     position_limits_rad: dict[str, tuple[float, float]]  # by joint name; missing → ±3.14
     torque_limits_nm: dict[str, float]  # by joint suffix (e.g. "KN", "SP", "F1", "NKY")
     has_wrist_roll: bool = True
+    #: The robot's name as users know it, for messages ("DRC-Hubo").
+    title: str = ""
     # Nominal / maximum speeds per joint group [rad/s] (HuboCan description).
     speed_nominal_rad_s: dict[str, float] = field(
         default_factory=lambda: {"leg": 0.8, "knee": 0.4, "arm": 1.0, "finger": 1.0}
@@ -91,6 +93,7 @@ _DRC_TORQUES = {
 
 DRC_HUBO = RobotParams(
     name="drc-hubo",
+    title="DRC-Hubo",
     half_hip_width_m=0.0885,
     torso_to_hip_pitch_m=0.164,
     thigh_m=0.330,
@@ -130,6 +133,7 @@ _HUBO2_LIMITS = {
 
 HUBO2PLUS = RobotParams(
     name="hubo2plus",
+    title="Hubo2+",
     half_hip_width_m=0.0885,
     # Sources give 0.18–0.32; this value makes thigh + shin + ankle + hip drop match the
     # published 0.991 m torso height with a 0.111 m ankle.
