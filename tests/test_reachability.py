@@ -10,7 +10,7 @@ import time
 import pytest
 
 from execute.batch.jobs import PlanJob, plan_job
-from ladders.loader import load_ladder
+from ladders.loader import ladder_to_yaml, load_ladder
 from planner.cli import main
 from planner.reachability import (
     LadderOutOfReach,
@@ -66,8 +66,6 @@ def test_rungs_beyond_the_step_height_are_refused_by_the_spacing():
 
 def test_plan_ladder_refuses_an_out_of_reach_ladder_in_under_5_s(tmp_path, capsys):
     spec = tmp_path / "wide.yaml"
-    from ladders.loader import ladder_to_yaml
-
     text = ladder_to_yaml(load_ladder("drc")).replace("name: drc", "name: wide")
     assert "spacing_m: 1.35" in text
     spec.write_text(text.replace("spacing_m: 1.35", "spacing_m: 2.2"))
