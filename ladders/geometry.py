@@ -293,11 +293,8 @@ class LadderGeometry:
 
     # --- landing ------------------------------------------------------------------
     def _rung_line_point_L(self, height_m: float) -> np.ndarray:
-        """The rung line's point at ``height_m`` above the floor, in L [m] (computed as
-        `LadderSpec.rung_run_m` does, so that the rails' ends are those of a ladder
-        without a landing to the last bit)."""
-        a = self.spec.slope_rad
-        return np.array([height_m * math.cos(a) / math.sin(a), 0.0, height_m])
+        """The rung line's point at ``height_m`` above the floor, in L [m]."""
+        return np.array([self.spec.run_at_height_m(height_m), 0.0, height_m])
 
     @property
     def landing_top_height_m(self) -> float:
@@ -315,7 +312,8 @@ class LadderGeometry:
         if not s.has_landing:
             return ()
         top = self.landing_top_height_m
-        front_x = self._rung_line_point_L(top)[0] - s.rung_depth_m / 2
+        edge_x = s.run_at_height_m(top)  # where the rung line meets the landing's top
+        front_x = edge_x - s.rung_depth_m / 2
         back_x = front_x + s.landing_depth_m
         half = np.array([s.landing_depth_m / 2, s.landing_width_m / 2,
                          LANDING_THICKNESS_M / 2])
@@ -324,15 +322,14 @@ class LadderGeometry:
                                                       self.to_world(centre_L)), half)]
         if s.landing_handrails:
             R = self.R_world_ladder @ _rot_y(math.pi / 2)  # local z along x_L
-            start_x = self._rung_line_point_L(top)[0]
             r = s.rail_radius_m
             for side in SIDES:
-                centre_L = np.array([(start_x + back_x) / 2,
+                centre_L = np.array([(edge_x + back_x) / 2,
                                      _SIDE_SIGN[side] * s.rail_spacing_m / 2,
                                      top + s.rail_height_m])
                 out.append(Solid(f"handrail_{side}", "cylinder",
                                  make_transform(R, self.to_world(centre_L)),
-                                 np.array([r, r, (back_x - start_x) / 2])))
+                                 np.array([r, r, (back_x - edge_x) / 2])))
         return tuple(out)
 
     # --- everything ---------------------------------------------------------------

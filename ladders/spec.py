@@ -244,7 +244,12 @@ class LadderSpec:
 
     def rung_run_m(self, i: int) -> float:
         """Horizontal distance d_i of rung ``i``'s top centre from the L origin along x_L [m]."""
-        return self.rung_height_m(i) * math.cos(self.slope_rad) / math.sin(self.slope_rad)
+        return self.run_at_height_m(self.rung_height_m(i))
+
+    def run_at_height_m(self, height_m: float) -> float:
+        """Horizontal distance along x_L of the rung line's point ``height_m`` above the
+        floor [m]."""
+        return height_m * math.cos(self.slope_rad) / math.sin(self.slope_rad)
 
     def as_dict(self) -> dict[str, Any]:
         """All fields as a flat ``{field: value}`` dict (for JSON sidecars)."""

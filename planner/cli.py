@@ -168,7 +168,7 @@ def _no_plan_message(exc, planner, spec, current, time_limit_s: float) -> str:
 def _plan(args: argparse.Namespace, err) -> int:
     from ladders.loader import load_ladder
     from planner.output import write_plan
-    from planner.reachability import LadderOutOfReach, check_reach
+    from planner.reachability import LadderOutOfReach
     from planner.search import ClimbPlanner, PlannerConfig, PlanningFailed
     from planner.time_limit import HARD_LIMIT_GRACE_S, TimeLimitExceeded, hard_time_limit
     from primitives.library import climb_sequence
@@ -177,18 +177,17 @@ def _plan(args: argparse.Namespace, err) -> int:
 
     t0 = time.perf_counter()
     spec = load_ladder(args.ladder)
-    try:  # before the planner's models load: a ladder out of reach is refused at once
-        check_reach(spec, args.robot)
-    except LadderOutOfReach as exc:
-        err.print(f"no plan: {exc}", markup=False, highlight=False, soft_wrap=True)
-        return 1
     config = PlannerConfig(samples_per_step=args.samples, resolution_rad=args.resolution,
                            time_limit_s=args.time_limit, arm_strategy=args.arm_strategy,
                            max_torque_ratio=args.max_torque_ratio,
                            position_torque_share=args.position_torque_share,
                            foot_cop_margin_m=args.foot_cop_margin,
                            foot_friction_share=args.foot_friction_share)
-    planner = ClimbPlanner(spec, robot=args.robot, config=config, seed=args.seed)
+    try:
+        planner = ClimbPlanner(spec, robot=args.robot, config=config, seed=args.seed)
+    except LadderOutOfReach as exc:
+        err.print(f"no plan: {exc}", markup=False, highlight=False, soft_wrap=True)
+        return 1
     top = planner.top_rung() if args.top_rung is None else args.top_rung
     if not 0 <= top < spec.num_rungs:
         raise InputError(f"option --top-rung is {top}; ladder '{spec.name}' has rungs "

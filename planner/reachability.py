@@ -34,7 +34,7 @@ import numpy as np
 
 from ladders.spec import LadderSpec
 from robot.errors import HuboLadderError
-from robot.joints import JOINT_NAMES
+from robot.joints import JOINT_INDEX
 from robot.limits import joint_limits
 from robot.params import RobotParams, robot_params
 
@@ -80,10 +80,10 @@ def _sole_offsets(robot: str) -> list[np.ndarray]:
     level sole relative to its hip over the hip-pitch × knee grid within limits [m]."""
     p: RobotParams = robot_params(robot)
     lim = joint_limits(robot)
-    col = {name: i for i, name in enumerate(JOINT_NAMES)}
-    hp_lo, hp_hi = lim.lower_rad[col["LHP"]], lim.upper_rad[col["LHP"]]
-    kn_lo, kn_hi = lim.lower_rad[col["LKN"]], lim.upper_rad[col["LKN"]]
-    ap_lo, ap_hi = lim.lower_rad[col["LAP"]], lim.upper_rad[col["LAP"]]
+    i_hp, i_kn, i_ap = JOINT_INDEX["LHP"], JOINT_INDEX["LKN"], JOINT_INDEX["LAP"]
+    hp_lo, hp_hi = lim.lower_rad[i_hp], lim.upper_rad[i_hp]
+    kn_lo, kn_hi = lim.lower_rad[i_kn], lim.upper_rad[i_kn]
+    ap_lo, ap_hi = lim.lower_rad[i_ap], lim.upper_rad[i_ap]
     hp, kn = np.meshgrid(np.linspace(hp_lo, hp_hi, _HIP_SAMPLES),
                          np.linspace(kn_lo, kn_hi, _KNEE_SAMPLES), indexing="ij")
     hp, kn = hp.ravel(), kn.ravel()

@@ -256,14 +256,19 @@ def closed_hand_wrist_pitch_range_rad(kin: HuboKinematics, collision: CollisionM
 
 
 class ClimbPlanner:
-    """Plans a climb of one ladder for one robot."""
+    """Plans a climb of one ladder for one robot.
+
+    Raises:
+        LadderOutOfReach: on construction, when the reach pre-check rules the ladder out
+            for this robot (`planner.reachability`).
+    """
 
     def __init__(self, spec: LadderSpec, robot: str = "drc-hubo",
                  config: PlannerConfig = PlannerConfig(), seed: int = 1):
         from ladders.collision import ladder_collision_objects
 
+        check_reach(spec, robot)  # before the models load: out of reach is refused at once
         self.spec = spec
-        self.robot = robot
         self.geom = LadderGeometry(spec)
         self.kin = HuboKinematics.load(robot)
         self.collision = CollisionModel(self.kin, ladder_collision_objects(spec),
@@ -678,10 +683,7 @@ class ClimbPlanner:
     def plan(self, top_rung: int | None = None,
              progress: Callable[[int, int, Step, StepStats], None] | None = None
              ) -> SearchResult:
-        """Search the whole climb; raises `LadderOutOfReach` when the pre-check rules the
-        ladder out (`planner.reachability`), `PlanningFailed` when the time or samples run
-        out."""
-        check_reach(self.spec, self.robot)
+        """Search the whole climb; raises `PlanningFailed` when the time or samples run out."""
         t_start = time.perf_counter()
         top = self.top_rung() if top_rung is None else top_rung
         if not 0 <= top < self.spec.num_rungs:

@@ -80,7 +80,7 @@ def test_plan_ladder_refuses_an_out_of_reach_ladder_in_under_5_s(tmp_path, capsy
 def test_the_planner_and_a_batch_job_refuse_it_too(tmp_path):
     wide = dataclasses.replace(load_ladder("drc"), name="wide", rail_spacing_m=2.2)
     with pytest.raises(LadderOutOfReach, match="rails 2.20 m apart"):
-        ClimbPlanner(wide).plan()
+        ClimbPlanner(wide)
     with pytest.raises(LadderOutOfReach):
         check_reach(wide, "drc-hubo")
     out = plan_job(PlanJob(ladder_key="wide", ladder=wide, seed=1), str(tmp_path))

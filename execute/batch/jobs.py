@@ -205,18 +205,18 @@ def plan_job(job: PlanJob, out_dir: str) -> dict:
         timing [s].
     """
     from planner.output import write_plan
-    from planner.reachability import LadderOutOfReach, check_reach
+    from planner.reachability import LadderOutOfReach
     from planner.search import ClimbPlanner, PlannerConfig, PlanningFailed
     from planner.timing import TimingError
 
     t0 = time.perf_counter()
     try:
-        check_reach(job.ladder, job.robot)
+        planner = ClimbPlanner(job.ladder, robot=job.robot,
+                               config=PlannerConfig(time_limit_s=job.time_limit_s),
+                               seed=job.seed)
     except LadderOutOfReach as exc:
         return {**_NO_PLAN, "plan_s": time.perf_counter() - t0, "top_rung": job.top_rung,
                 "where": "reach", "why": str(exc)}
-    planner = ClimbPlanner(job.ladder, robot=job.robot,
-                           config=PlannerConfig(time_limit_s=job.time_limit_s), seed=job.seed)
     top = planner.top_rung() if job.top_rung is None else job.top_rung
     try:
         with hard_time_limit(job.time_limit_s + HARD_LIMIT_GRACE_S):

@@ -6,6 +6,8 @@ from __future__ import annotations
 import enum
 from dataclasses import asdict, dataclass, field
 
+from robot.vocabulary import FailureCause
+
 __all__ = ["MotionEvent", "MotionEventKind", "MotionStop"]
 
 
@@ -57,11 +59,13 @@ class MotionEvent:
 
 @dataclass(frozen=True)
 class MotionStop:
-    """Why the layer stopped the climb: it holds the pose, every verified grip kept."""
+    """Why the layer stopped the climb: it holds the pose, every verified grip kept.
+    ``cause`` is the run's failure cause (a grasp or a foothold it could not verify)."""
 
     time_s: float
     line: int
     limb: str
     reason: str
+    cause: FailureCause
     tries: int = 0
     details: dict = field(default_factory=dict)

@@ -71,6 +71,7 @@ from robot.joints import ARM_JOINTS, FINGER_JOINTS, JOINT_NAMES, joint_indices
 from robot.limits import joint_limits
 from robot.motors import motor_table
 from robot.plan_sidecar import PlanSidecar, Segment, segment_of_lines
+from robot.vocabulary import FailureCause
 
 __all__ = ["MotionLayer"]
 
@@ -504,12 +505,12 @@ class MotionLayer:
                             "grasp is verified")
 
     def _settle_offset(self, limb: str) -> None:
-        """A time-based offset that has arrived stays while the limb holds: index it by
-        line again."""
+        """A time-based offset stays where it is now while the limb holds (it has arrived,
+        or a foot reaching down found its rung mid-way): index it by line again."""
         blend = self._offsets.get(limb)
         if blend is not None and blend.time_based:
-            self._offsets[limb] = _Blend(blend.end, blend.end, float(self._line),
-                                         float(self._line))
+            held = blend.end if self._now >= blend.t1 else blend.at(self._now)
+            self._offsets[limb] = _Blend(held, held, float(self._line), float(self._line))
 
     def _grasp_verified(self, g: _Regrasp) -> None:
         limb = f"{g.side}_hand"
@@ -541,8 +542,8 @@ class MotionLayer:
 
     def _stop(self, g: _Regrasp, reason: str) -> None:
         self._open_fingers.add(g.side)
-        self.stop = MotionStop(self._now, self._line + 1, f"{g.side}_hand", reason, g.tries,
-                               {"rail": g.rail})
+        self.stop = MotionStop(self._now, self._line + 1, f"{g.side}_hand", reason,
+                               FailureCause.GRASP_UNVERIFIED, g.tries, {"rail": g.rail})
         self._event(MotionEventKind.STOP, f"{g.side}_hand", 0.0, reason)
         self._regrasp = None
 
@@ -575,7 +576,7 @@ class MotionLayer:
                         self._landing_depth_m(f, elapsed),
                         f"stands on {f.target} ({load:.0f} N) after {elapsed:.2f} s"
                         + (" of reaching down" if f.phase == "reach" else " of waiting"))
-            self._freeze_offset(limb)
+            self._settle_offset(limb)
             self._landing = None
             self.player.resume(now)
             return
@@ -604,21 +605,12 @@ class MotionLayer:
             return 0.0
         return self.config.landing_reach_m * min_jerk(elapsed_s / f.reach_s)
 
-    def _freeze_offset(self, limb: str) -> None:
-        """A limb's offset stops where it is now (a reach found its hold mid-way) and is
-        kept while the limb holds."""
-        blend = self._offsets.get(limb)
-        if blend is None:
-            return
-        now = blend.at(self._now if blend.time_based else float(self._line))
-        self._offsets[limb] = _Blend(now, now, float(self._line), float(self._line))
-
     def _stop_landing(self, f: _Landing, load_n: float, reached_m: float) -> None:
         reason = (f"{f.side}_foot found no rung: its F/T read {load_n:.0f} N after reaching "
                   f"{reached_m * 100:.0f} cm below its planned hold on {f.target}: the weight "
                   "was not moved onto it")
-        self.stop = MotionStop(self._now, self._line + 1, f"{f.side}_foot", reason, 0,
-                               {"rung": f.target})
+        self.stop = MotionStop(self._now, self._line + 1, f"{f.side}_foot", reason,
+                               FailureCause.FOOTHOLD_UNVERIFIED, 0, {"rung": f.target})
         self._event(MotionEventKind.STOP, f"{f.side}_foot", reached_m, reason)
         self._landing = None
 

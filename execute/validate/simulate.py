@@ -46,7 +46,7 @@ from ladders.geometry import LadderGeometry
 from ladders.spec import LadderSpec
 from robot.errors import InputError
 from robot.plan_sidecar import PlanSidecar
-from robot.vocabulary import ArmStrategy, FailureCause, HoldTargetKind, Limb
+from robot.vocabulary import ArmStrategy, HoldTargetKind, Limb
 
 __all__ = ["STRATEGIES", "SimulationLog", "SimulationOptions", "SimulationRun", "simulate"]
 
@@ -311,9 +311,7 @@ def _final_verdict(failure: Failure | None, motion, monitor: VerdictMonitor, tim
     a foothold it could not verify); else the monitor's checks of the final stance."""
     if failure is None and motion is not None and motion.stop is not None:
         stop = motion.stop
-        cause = (FailureCause.FOOTHOLD_UNVERIFIED if stop.limb.endswith("_foot")
-                 else FailureCause.GRASP_UNVERIFIED)
-        failure = Failure(cause, stop.time_s, stop.line,
+        failure = Failure(stop.cause, stop.time_s, stop.line,
                           f"the motion layer held the pose and stopped: {stop.reason}",
                           {"limb": stop.limb, "tries": stop.tries, **stop.details})
     if failure is not None:
