@@ -1,7 +1,7 @@
 """Benchmark: ``hubo-bridge`` on loopback, state write → arrival at a bridge subscriber.
 
 Three processes, as on the robot and the operator's computer: a state writer standing in
-for the daemon (a ``state`` sample, 2192 B, every 5 ms on absolute deadlines), a
+for the daemon (a ``state`` sample, 2200 B, every 5 ms on absolute deadlines), a
 ``hubo-bridge robot`` process (mutual TLS, access control), and this process, an
 operator's `BridgeOperator` subscribed to the state. Latency: ``CLOCK_MONOTONIC`` at the
 subscriber's callback minus the sample's ``time_ns`` (stamped by the channel write; one

@@ -373,6 +373,7 @@ class DaemonLoop:
         s["tick"] = st.ticks
         s["overruns"] = st.overruns
         s["time_s"] = now_s
+        s["start_ns"] = self._t0_ns
         s["ref"] = out.ref_sent_rad
         s["pos"] = sensors.pos_rad
         s["vel"] = sensors.vel_rad_s

@@ -168,10 +168,9 @@ class NeckLink:
     def _live(self, channel) -> np.ndarray | None:
         """``channel``'s newest sample if written since the daemon started (older ones the
         daemon ignores)."""
-        s = self.console.state_now()
-        t0_ns = int(s["time_ns"]) - round(float(s["time_s"]) * 1e9)
+        start_ns = int(self.console.state_now()["start_ns"])
         sample = channel.read_latest()
-        return sample if sample is not None and int(sample["time_ns"]) >= t0_ns else None
+        return sample if sample is not None and int(sample["time_ns"]) >= start_ns else None
 
     def goals_rad(self) -> dict[str, float]:
         """Every neck joint's commanded goal [rad] (see the module docstring)."""

@@ -24,7 +24,7 @@ Sizes (bytes, checked by the tests):
 | ``ref-neck`` | `REF_DTYPE` (only the neck entries are used) | 741 |
 | ``board-cmd`` | `BOARD_CMD_DTYPE` | 76 |
 | ``pwm-gains`` | `PWM_GAINS_DTYPE` | 1300 |
-| ``state`` | `STATE_DTYPE` | 2192 |
+| ``state`` | `STATE_DTYPE` | 2200 |
 """
 
 from __future__ import annotations
@@ -141,13 +141,16 @@ IMU_DTYPE = np.dtype(
 )
 POWER_DTYPE = np.dtype([("V", "<f8"), ("I", "<f8"), ("P", "<f8")], align=False)  # [V, A, W]
 
-#: ``state``: what the daemon measured. 2192 bytes.
+#: ``state``: what the daemon measured. 2200 bytes.
 STATE_DTYPE = np.dtype(
     HEADER_FIELDS
     + [
         ("tick", "<u8"),  # 200 Hz ticks since the daemon started
         ("overruns", "<u8"),  # ticks that missed their deadline
-        ("time_s", "<f8"),  # daemon time since start [s]
+        ("time_s", "<f8"),  # daemon time since start [s], at the tick's start
+        # CLOCK_MONOTONIC at the daemon's start [ns]: a ref sample stamped before it is
+        # stale. (time_ns minus time_s is later by the tick's work: time_ns is the write.)
+        ("start_ns", "<i8"),
         ("ref", "<f8", (NUM_JOINTS,)),  # reference sent to the board [rad]
         ("pos", "<f8", (NUM_JOINTS,)),  # [rad]
         ("vel", "<f8", (NUM_JOINTS,)),  # [rad/s]

@@ -177,6 +177,10 @@ def test_stale_reference_from_before_start_and_malformed_ones_are_ignored():
                       LoopConfig(startup_ignore_s=0.0))
     loop.run(max_ticks=10)
     assert np.all(be.sent[-1].ref_rad == 0.0)
+    # The state tells its readers (hubo-neck, the station) which samples are stale: its
+    # write stamp less time_s is later than the start by each tick's work.
+    start_ns = int(loop.state["start_ns"])
+    assert int(w.ref.read_latest()["time_ns"]) < start_ns <= int(loop.state["time_ns"])
     bad = _ref(playing=0, RSP=-1.0)
     bad["mode"][3] = 7
     w.ref.write(bad)

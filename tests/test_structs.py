@@ -21,7 +21,7 @@ from daemon.structs import (
 
 @pytest.mark.parametrize(
     "dtype,size",
-    [(REF_DTYPE, 741), (BOARD_CMD_DTYPE, 76), (PWM_GAINS_DTYPE, 1300), (STATE_DTYPE, 2192)],
+    [(REF_DTYPE, 741), (BOARD_CMD_DTYPE, 76), (PWM_GAINS_DTYPE, 1300), (STATE_DTYPE, 2200)],
 )
 def test_sizes_match_the_docstring(dtype, size):
     assert dtype.itemsize == size
@@ -54,6 +54,6 @@ def test_board_commands_and_describe():
     c["dvalues"][:3] = (60.0, 5.0, 6.0)
     assert BoardCommandType(int(c["type"])) is BoardCommandType.SET_GAINS
     text = describe(STATE_DTYPE)
-    assert text.startswith("2192 bytes")
+    assert text.startswith("2200 bytes")
     assert "ft: mx,my,fz[4]" in text
     assert np.dtype(REF_DTYPE).fields["ref"][0].shape == (40,)

@@ -5,7 +5,7 @@ Keys are ``hubo/<instance>/<topic>``, one instance per daemon as for the channel
 ================  =========  =================================================  ==========
 topic             zenoh      payload                                            who writes
 ================  =========  =================================================  ==========
-``state``         put        a ``state`` sample, the channel's bytes (2192 B)   robot
+``state``         put        a ``state`` sample, the channel's bytes (2200 B)   robot
 ``ref``           put        a ``ref`` sample (741 B)                           operator
 ``cmd/console``   query      a ``hubo-console`` board command, UTF-8 text       operator
 ``cmd/neck``      query      one ``hubo-neck`` key                              operator

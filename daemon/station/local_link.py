@@ -50,8 +50,7 @@ class LocalLink(StationLink):
         if s is None:
             return None
         r = self._channel("ref").read_latest()
-        start_ns = int(s["time_ns"]) - round(float(s["time_s"]) * 1e9)
-        mode = r["mode"] if r is not None and int(r["time_ns"]) >= start_ns else None
+        mode = r["mode"] if r is not None and int(r["time_ns"]) >= int(s["start_ns"]) else None
         return StateReading(s, mode, int(s["time_ns"]))
 
     def _console(self, line: str) -> str:
