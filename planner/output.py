@@ -280,6 +280,7 @@ def _metrics(result: SearchResult, planner: ClimbPlanner, timed: TimedPlan,
         "min_clearance_line": worst_line,
         "clearance_every_lines": clearance_every,
         "leg_clearance_m": planner.config.leg_clearance_m,
+        "arm_clearance_m": planner.config.arm_clearance_m,
         "steps_at_min_leg_clearance": sum(st.leg_clearance_m < planner.config.leg_clearance_m
                                           for st in stats),
         "duration_s": timed.duration_s,

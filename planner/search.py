@@ -99,6 +99,10 @@ class PlannerConfig:
     # 0.254 m) has little room for the legs, and the margin then costs minutes of search.
     min_leg_clearance_m: float = 0.01
     leg_clearance_samples: int = 10
+    # Upper arms and forearms keep this far from the ladder [m]. Planned at none, the
+    # right upper arm passed 0.2–1.5 cm from the DRC's right stringer in the mount of 9
+    # of 10 plans, and one simulated climb hit it at 113 N (docs/decisions/arm-clearance.md).
+    arm_clearance_m: float = 0.02
     arm_strategy: str = DEFAULT_ARM_STRATEGY  # how gripping arms are driven (arm_capacity)
     # Largest planned joint torque / limit, compliant arm joints included (their limit is
     # their PWM clamp). The reserve the legs need is `position_torque_share`'s.
@@ -272,7 +276,7 @@ class ClimbPlanner:
         self.geom = LadderGeometry(spec)
         self.kin = HuboKinematics.load(robot)
         self.collision = CollisionModel(self.kin, ladder_collision_objects(spec),
-                                        config.leg_clearance_m)
+                                        config.leg_clearance_m, config.arm_clearance_m)
         for side in "LR":  # the IK and the checker both keep the wrists inside this range
             self.kin.wrapper.set_joint_limits(
                 f"{side}WP", *closed_hand_wrist_pitch_range_rad(self.kin, self.collision, side))

@@ -5,11 +5,12 @@ from types import SimpleNamespace
 import mujoco
 import numpy as np
 import pinocchio as pin
+import pytest
 
 from ladders.collision import ladder_collision_objects
 from ladders.loader import load_ladder
 from ladders.scene import build_scene
-from planner.configuration.collision import CollisionModel
+from planner.configuration.collision import ARM_LINKS, LEG_LINKS, CollisionModel
 from robot.mjcf import ROBOT_CONTYPE, joint_qpos_addresses
 from robot.params import robot_params
 from robot.urdf import robot_urdf
@@ -67,7 +68,8 @@ def test_planner_and_simulator_measure_the_same_distances_to_the_rungs():
     assert compared > 50
 
 
-def _model_with_box_near(link: str, gap_m: float, leg_clearance_m: float):
+def _model_with_box_near(link: str, gap_m: float, leg_clearance_m: float,
+                         arm_clearance_m: float = 0.0):
     """A CollisionModel whose only obstacle is a small box ``gap_m`` in front (+x) of
     ``link``'s capsule in the zero pose lifted off the floor, and that pose."""
     import coal
@@ -81,18 +83,26 @@ def _model_with_box_near(link: str, gap_m: float, leg_clearance_m: float):
     probe = CollisionModel(robot, [])
     pin.updateGeometryPlacements(model, data, probe.geom, probe.gdata, q)
     k = next(i for i, g in enumerate(probe.geom.geometryObjects) if g.name == f"{link}/0")
-    front_m = probe.gdata.oMg[k].translation + (probe.geom.geometryObjects[k].geometry.radius,
-                                                0.0, 0.0)
+    shape, pose = probe.geom.geometryObjects[k].geometry, probe.gdata.oMg[k]
+    reach_x = (shape.radius if isinstance(shape, coal.Capsule)  # a box: its extent along x
+               else float(np.abs(pose.rotation[0]) @ shape.halfSide))
+    front_m = pose.translation + (reach_x, 0.0, 0.0)
     half = 0.02
     box = coal.Box(2 * half, 2 * half, 2 * half)
     tf = coal.Transform3s(np.eye(3), front_m + (gap_m + half, 0.0, 0.0))
-    return CollisionModel(robot, [("box", box, tf)], leg_clearance_m), q
+    return CollisionModel(robot, [("box", box, tf)], leg_clearance_m, arm_clearance_m), q
 
 
-def test_legs_keep_their_clearance_and_other_links_do_not():
-    for link, margin_applies in (("L_shin", True), ("L_thigh", True), ("L_forearm", False)):
+@pytest.mark.parametrize("clearance", ["legs", "arms"])
+def test_legs_and_arms_keep_their_own_clearance_and_other_links_do_not(clearance):
+    """A link 0.5 cm from the ladder collides under a 1 cm clearance of its own group
+    only: the legs' applies to thighs and shins, the arms' to upper arms and forearms;
+    other links (the torso here) keep none."""
+    legs_m, arms_m = (0.01, 0.0) if clearance == "legs" else (0.0, 0.01)
+    for link in ("L_shin", "L_thigh", "R_upper_arm", "L_forearm", "torso"):
+        margin_applies = link in (LEG_LINKS if clearance == "legs" else ARM_LINKS)
         without, q = _model_with_box_near(link, 0.005, 0.0)
-        with_clearance, _ = _model_with_box_near(link, 0.005, 0.01)
+        with_clearance, _ = _model_with_box_near(link, 0.005, legs_m, arms_m)
         assert not without.in_collision(q)
         assert with_clearance.in_collision(q) is margin_applies, link
         # the report stays the true distance

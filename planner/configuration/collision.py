@@ -28,6 +28,9 @@ LIMB_END_LINKS = {
 FLOOR = "floor"
 #: Links that `CollisionModel`'s ``leg_clearance_m`` keeps off the ladder.
 LEG_LINKS = ("L_thigh", "L_shin", "R_thigh", "R_shin")
+#: Links that `CollisionModel`'s ``arm_clearance_m`` keeps off the ladder (the hands and
+#: fingers touch the rails they hold).
+ARM_LINKS = ("L_upper_arm", "L_forearm", "R_upper_arm", "R_forearm")
 
 
 def _shape(g: Geom) -> tuple[coal.CollisionGeometry, np.ndarray]:
@@ -80,9 +83,10 @@ class CollisionModel:
 
     def __init__(self, kin: HuboKinematics,
                  environment: list[tuple[str, coal.CollisionGeometry, coal.Transform3s]],
-                 leg_clearance_m: float = 0.0):
-        """``leg_clearance_m``: thighs and shins count as colliding with the ladder when
-        closer than this [m] (`in_collision`; `report` gives the true distance)."""
+                 leg_clearance_m: float = 0.0, arm_clearance_m: float = 0.0):
+        """``leg_clearance_m``, ``arm_clearance_m``: thighs and shins, upper arms and
+        forearms count as colliding with the ladder when closer than this [m]
+        (`in_collision`; `report` gives the true distance)."""
         self.kin = kin
         tree = build_tree(kin.params)
         model = kin.model
@@ -132,12 +136,18 @@ class CollisionModel:
                 self.env_pair_index.append((self.robot_link_of[i], name))
         self.n_self_pairs = len(self.self_pairs)
         self.gdata = pin.GeometryData(geom)
-        self._leg_pairs = [self.n_self_pairs + k
-                           for k, (link, env) in enumerate(self.env_pair_index)
-                           if link in LEG_LINKS and env != FLOOR]
+        self._leg_pairs = self._ladder_pairs(LEG_LINKS)
         self.leg_clearance_m = -1.0
         self.set_leg_clearance(leg_clearance_m)
+        self.arm_clearance_m = arm_clearance_m
+        for idx in self._ladder_pairs(ARM_LINKS):
+            self.gdata.collisionRequests[idx].security_margin = arm_clearance_m
         self._allowed: frozenset[tuple[str, str]] = frozenset()
+
+    def _ladder_pairs(self, links: tuple[str, ...]) -> list[int]:
+        """Indices of the pairs of ``links`` against the ladder's parts (not the floor)."""
+        return [self.n_self_pairs + k for k, (link, env) in enumerate(self.env_pair_index)
+                if link in links and env != FLOOR]
 
     def set_leg_clearance(self, clearance_m: float) -> None:
         """Keep thighs and shins ``clearance_m`` off the ladder from now on [m]."""
