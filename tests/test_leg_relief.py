@@ -121,9 +121,9 @@ def test_the_lift_pulls_each_gripping_hand_the_way_that_unloads_the_joint(model)
     for _ in range(400):
         relief.update(["left"], True, hot, TICK_S)
     assert relief.lift_n == pytest.approx(40.0)
-    ff = relief.feedforward_nm(["left", "right"], q, np.eye(3))
+    ff = relief.feedforward_nm(["left", "right"], q, np.eye(3), hot)
     for side in ("left", "right"):
-        d = relief.direction(q, np.eye(3), "left_foot", f"{side}_hand")
+        d = relief.direction(q, np.eye(3), "left_foot", f"{side}_hand", hot)
         assert d[2] >= 0.0 and np.linalg.norm(d) == pytest.approx(1.0)
         grad = model.stance_torque_gradient(q, np.eye(3), JOINT_INDEX["LKN"], "left_foot",
                                             f"{side}_hand")
@@ -131,6 +131,42 @@ def test_the_lift_pulls_each_gripping_hand_the_way_that_unloads_the_joint(model)
         cols = list(model.chains[f"{side}_hand"].columns)
         push = model.force_torques(q, np.eye(3), f"{side}_hand", 20.0 * d)
         np.testing.assert_allclose(ff[cols], -push[cols])
-    ff_left = relief.feedforward_nm(["left"], q, np.eye(3))
+    ff_left = relief.feedforward_nm(["left"], q, np.eye(3), hot)
     right = [JOINT_INDEX[n] for n in ARM_JOINTS["right"]]
     assert not ff_left[right].any()
+
+
+def test_the_lift_does_not_load_another_loaded_joint_of_the_leg(model):
+    """A hip yaw already near its limit is not loaded further by the knee's relief: the
+    push is the fastest one projected onto those that leave it be (a DRC mount's left hip
+    yaw went from 0.05 to 0.99 of its limit under an 80 N knee relief); a joint under
+    the guard's share does not bend it."""
+    q = _climbing_arms()
+    q[JOINT_INDEX["LHP"]], q[JOINT_INDEX["LKN"]], q[JOINT_INDEX["LAP"]] = -0.5, 1.0, -0.5
+    q[JOINT_INDEX["LHY"]] = 0.3
+    relief = LegRelief(model, max_lift_n=40.0)
+    hot = _torque_for("LKN", -0.95)
+    for _ in range(400):
+        relief.update(["left"], True, hot, TICK_S)
+    hy, kn = JOINT_INDEX["LHY"], JOINT_INDEX["LKN"]
+    for side in ("left", "right"):
+        hand = f"{side}_hand"
+        fastest = relief.direction(q, np.eye(3), "left_foot", hand, hot)
+        g_hy = model.stance_torque_gradient(q, np.eye(3), hy, "left_foot", hand)
+        assert abs(g_hy @ fastest) > 1e-3  # the fastest push does move the hip yaw
+        both = model.stance_torque_gradient(q, np.eye(3), np.array([hy, kn]), "left_foot",
+                                            hand)
+        np.testing.assert_array_equal(both[0], g_hy)
+        loaded = hot.copy()
+        loaded[hy] = 0.9 * relief.limit_nm[hy] * np.sign(g_hy @ fastest)  # ... the wrong way
+        d = relief.direction(q, np.eye(3), "left_foot", hand, loaded)
+        assert np.sign(loaded[hy]) * (g_hy @ d) <= 1e-9
+        assert d[2] >= -1e-12
+        if np.linalg.norm(d) > 0:  # what is left of the push still unloads the knee
+            assert np.linalg.norm(d) == pytest.approx(1.0)
+            g_kn = model.stance_torque_gradient(q, np.eye(3), kn, "left_foot", hand)
+            assert g_kn @ d >= 0.0
+        below = hot.copy()
+        below[hy] = 0.5 * loaded[hy] / 0.9  # half its limit: not guarded
+        np.testing.assert_array_equal(
+            relief.direction(q, np.eye(3), "left_foot", hand, below), fastest)

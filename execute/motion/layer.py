@@ -711,7 +711,8 @@ class MotionLayer:
                         "lift more")
         if lift == 0.0:
             return ff
-        return ff + relief.feedforward_nm(lifting, s.pos_rad, self.estimate.R_tilt)
+        return ff + relief.feedforward_nm(lifting, s.pos_rad, self.estimate.R_tilt,
+                                          self._sensed_torque_nm)
 
     # ------------------------------------------------------------------ report
     def report(self) -> dict:

@@ -28,20 +28,31 @@ the stance foot takes the reaction, so the joint's torque changes along
 direction's downward part is dropped): that would load the feet. A vertical lift alone
 did not relieve knees on `ship`, where the knee's lever is mostly horizontal
 (docs/decisions/leg-relief.md).
+
+Nor may the push load another joint of that leg that is already loaded (above
+``guard_fraction`` of its limit) further: on a DRC mount (S21, seed 1) the 80 N that held
+the left knee at 0.76–0.89 of its limit on one foot drove the left hip yaw from 0.05 to
+0.99 of its limit in 8 s, and its board tripped. The direction is then the projection of
+the fastest one onto the cone of pushes that load none of them (and do not push down):
+the least change from it that the guard allows, found as a non-negative least-squares
+problem on the cone's polar (Moreau). A hand with no such push adds nothing.
 """
 
 from __future__ import annotations
 
 import numpy as np
+from scipy.optimize import nnls
 
 from execute.motion.robot_model import MotionRobotModel
-from robot.joints import JOINT_NAMES, joint_indices
+from robot.joints import JOINT_NAMES, LEG_JOINTS, joint_indices
 from robot.limits import joint_limits
 
 __all__ = ["WEIGHT_JOINTS", "LegRelief"]
 
 #: Per leg, the joints whose load is the body's weight on it (module docstring).
 WEIGHT_JOINTS = {"left": ("LHP", "LKN"), "right": ("RHP", "RKN")}
+#: Downward: the push's direction never has a part along it (module docstring).
+_DOWN = np.array([[0.0, 0.0, -1.0]])
 
 
 class LegRelief:
@@ -54,15 +65,21 @@ class LegRelief:
         release_fraction: share below which it shrinks (hysteresis).
         rate_n_per_s: how fast it grows or shrinks [N/s].
         max_lift_n: the largest extra lift of all hands together [N].
+        guard_fraction: share of its limit above which another joint of the relieved
+            leg may not be loaded further by the push.
     """
 
     def __init__(self, model: MotionRobotModel, robot: str = "drc-hubo",
                  onset_fraction: float = 0.85, release_fraction: float = 0.75,
-                 rate_n_per_s: float = 40.0, max_lift_n: float = 80.0):
+                 rate_n_per_s: float = 40.0, max_lift_n: float = 80.0,
+                 guard_fraction: float = 0.6):
         self.model = model
         self.limit_nm = joint_limits(robot).torque_max_nm
         self._leg_cols = {side: np.array(joint_indices(WEIGHT_JOINTS[side]))
                           for side in WEIGHT_JOINTS}
+        self._guard_cols = {f"{side}_foot": np.array(joint_indices(LEG_JOINTS[side]))
+                            for side in LEG_JOINTS}
+        self.guard_fraction = guard_fraction
         self.onset, self.release = onset_fraction, release_fraction
         self.rate_n_per_s, self.max_lift_n = rate_n_per_s, max_lift_n
         self.lift_n = 0.0
@@ -98,25 +115,43 @@ class LegRelief:
         return self.lift_n
 
     def direction(self, q_sensed_rad: np.ndarray, R_tilt: np.ndarray, foot: str,
-                  hand: str) -> np.ndarray:
+                  hand: str, torque_nm: np.ndarray) -> np.ndarray:
         """Unit direction (world) of the rail's push on ``hand`` that unloads the relieved
-        joint fastest, without a downward part; straight up if it has none."""
+        joint fastest, without a downward part and without loading another joint of
+        ``foot``'s leg above ``guard_fraction`` of its limit (``torque_nm``: the sensed
+        torques by column [N·m]); straight up if the fastest has only a downward part,
+        zero if the guard leaves no push."""
         gradient = self.model.stance_torque_gradient(q_sensed_rad, R_tilt, self.joint_col,
                                                      foot, hand)
-        d = -self.joint_sign * gradient
+        fastest = -self.joint_sign * gradient
+        d = fastest.copy()
         d[2] = max(d[2], 0.0)
+        cols = self._guard_cols[foot]
+        cols = cols[(cols != self.joint_col)
+                    & (np.abs(torque_nm[cols]) > self.guard_fraction * self.limit_nm[cols])]
+        if len(cols):
+            # each row: the growth of one guarded joint's |τ| per unit push
+            loading = np.sign(torque_nm[cols])[:, None] * self.model.stance_torque_gradient(
+                q_sensed_rad, R_tilt, cols, foot, hand)
+            if (loading @ d > 0.0).any():
+                polar = np.vstack([loading, _DOWN]).T  # (3, k + 1): the cone's polar
+                d = fastest - polar @ nnls(polar, fastest)[0]
+                if float(np.linalg.norm(d)) <= 1e-6 * float(np.linalg.norm(fastest)):
+                    return np.zeros(3)
         length = float(np.linalg.norm(d))
         return d / length if length > 1e-9 else np.array([0.0, 0.0, 1.0])
 
     def feedforward_nm(self, sides: list[str], q_sensed_rad: np.ndarray,
-                       R_tilt: np.ndarray) -> np.ndarray:
+                       R_tilt: np.ndarray, torque_nm: np.ndarray) -> np.ndarray:
         """Feed-forward torques by column [N·m] that make the rail push each hand of
-        ``sides`` by its share of the lift, along `direction` (zero off their arms)."""
+        ``sides`` by its share of the lift, along `direction` (zero off their arms);
+        ``torque_nm``: the sensed joint torques by column [N·m]."""
         out = np.zeros(len(q_sensed_rad))
         if self.lift_n <= 0.0 or not sides or self.joint_col < 0:
             return out
         for side in sides:
-            direction = self.direction(q_sensed_rad, R_tilt, self.joint_foot, f"{side}_hand")
+            direction = self.direction(q_sensed_rad, R_tilt, self.joint_foot, f"{side}_hand",
+                                       torque_nm)
             force = direction * (self.lift_n / len(sides))
             torque = self.model.force_torques(q_sensed_rad, R_tilt, f"{side}_hand", force)
             cols = list(self.model.chains[f"{side}_hand"].columns)

@@ -130,10 +130,12 @@ class MotionRobotModel:
         return out
 
     def stance_torque_gradient(self, q_cols_rad: np.ndarray, R_world_pelvis: np.ndarray,
-                               joint_col: int, foot: str, hand: str) -> np.ndarray:
-        """∂τ/∂f (3,) [N·m/N]: how the torque of leg joint ``joint_col`` changes with a
+                               joint_cols: int | np.ndarray, foot: str, hand: str
+                               ) -> np.ndarray:
+        """∂τ/∂f [N·m/N]: how the torque of leg joint ``joint_cols`` changes with a
         force f (world frame) of the environment on ``hand``'s palm, when the stance
-        foot ``foot`` (a limb name) takes its reaction.
+        foot ``foot`` (a limb name) takes its reaction; (3,) for one column, (k, 3) for
+        an array of k columns.
 
         The foot's wrench changes by ``−(f, r × f)`` about its sole (r from sole to palm),
         and a leg joint's torque is ``g − Jᵀw`` over its foot's wrench: ∂τ/∂f = a + b × r,
@@ -143,9 +145,9 @@ class MotionRobotModel:
         sole = self._frame_id[self.chains[foot].frame]
         palm = self._frame_id[self.chains[hand].frame]
         jacobian = pin.getFrameJacobian(self.model, d, sole, pin.LOCAL_WORLD_ALIGNED)
-        column = jacobian[:, self._v_of_col[joint_col]]
+        column = jacobian[:, self._v_of_col[joint_cols]]
         r = d.oMf[palm].translation - d.oMf[sole].translation
-        return column[:3] + np.cross(column[3:], r)
+        return (column[:3] + np.cross(column[3:], r, axis=0)).T
 
     def com_m(self, q_cols_rad: np.ndarray, T_world_pelvis: np.ndarray) -> np.ndarray:
         """Whole-body centre of mass in the world [m]."""
