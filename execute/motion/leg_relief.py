@@ -121,18 +121,18 @@ class LegRelief:
         ``foot``'s leg above ``guard_fraction`` of its limit (``torque_nm``: the sensed
         torques by column [N·m]); straight up if the fastest has only a downward part,
         zero if the guard leaves no push."""
-        gradient = self.model.stance_torque_gradient(q_sensed_rad, R_tilt, self.joint_col,
-                                                     foot, hand)
-        fastest = -self.joint_sign * gradient
+        cols = self._guard_cols[foot]
+        guarded = cols[(cols != self.joint_col)
+                       & (np.abs(torque_nm[cols]) > self.guard_fraction * self.limit_nm[cols])]
+        # one Jacobian for the relieved joint's gradient and the guarded joints'
+        gradients = self.model.stance_torque_gradient(
+            q_sensed_rad, R_tilt, np.r_[self.joint_col, guarded], foot, hand)
+        fastest = -self.joint_sign * gradients[0]
         d = fastest.copy()
         d[2] = max(d[2], 0.0)
-        cols = self._guard_cols[foot]
-        cols = cols[(cols != self.joint_col)
-                    & (np.abs(torque_nm[cols]) > self.guard_fraction * self.limit_nm[cols])]
-        if len(cols):
+        if len(guarded):
             # each row: the growth of one guarded joint's |τ| per unit push
-            loading = np.sign(torque_nm[cols])[:, None] * self.model.stance_torque_gradient(
-                q_sensed_rad, R_tilt, cols, foot, hand)
+            loading = np.sign(torque_nm[guarded])[:, None] * gradients[1:]
             if (loading @ d > 0.0).any():
                 polar = np.vstack([loading, _DOWN]).T  # (3, k + 1): the cone's polar
                 d = fastest - polar @ nnls(polar, fastest)[0]

@@ -140,8 +140,7 @@ class CollisionModel:
         self.leg_clearance_m = -1.0
         self.set_leg_clearance(leg_clearance_m)
         self.arm_clearance_m = arm_clearance_m
-        for idx in self._ladder_pairs(ARM_LINKS):
-            self.gdata.collisionRequests[idx].security_margin = arm_clearance_m
+        self._set_margin(self._ladder_pairs(ARM_LINKS), arm_clearance_m)
         self._allowed: frozenset[tuple[str, str]] = frozenset()
 
     def _ladder_pairs(self, links: tuple[str, ...]) -> list[int]:
@@ -149,13 +148,17 @@ class CollisionModel:
         return [self.n_self_pairs + k for k, (link, env) in enumerate(self.env_pair_index)
                 if link in links and env != FLOOR]
 
+    def _set_margin(self, pairs: list[int], clearance_m: float) -> None:
+        """``pairs`` count as colliding when closer than ``clearance_m`` [m]."""
+        for idx in pairs:
+            self.gdata.collisionRequests[idx].security_margin = clearance_m
+
     def set_leg_clearance(self, clearance_m: float) -> None:
         """Keep thighs and shins ``clearance_m`` off the ladder from now on [m]."""
         if clearance_m == self.leg_clearance_m:
             return
         self.leg_clearance_m = clearance_m
-        for idx in self._leg_pairs:
-            self.gdata.collisionRequests[idx].security_margin = clearance_m
+        self._set_margin(self._leg_pairs, clearance_m)
 
     def allow(self, contacts: dict[str, str]) -> None:
         """Let each limb's end links touch the object it holds: ``{limb: env name}``."""
