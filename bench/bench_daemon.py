@@ -6,7 +6,7 @@ robot holds), and records every tick's start [ns]. Period error = ``|Δstart −
 between consecutive ticks; an overrun shows as a large error (its skipped deadlines are
 also counted). Cases:
 
-- ``sim``: the MuJoCo board model on the DRC ladder (two 2.5 ms physics steps a tick);
+- ``sim``: the MuJoCo board model on the DRC ladder (four 1.25 ms physics steps a tick);
 - ``virtual CAN``: `daemon.can.backend.CanBackend` on python-can ``virtual`` buses with
   `daemon.can.emulator.BoardEmulator` answering from threads of the same process (the
   virtual interface does not cross processes), so the emulator's work shares the GIL;

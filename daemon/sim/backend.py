@@ -1,7 +1,7 @@
 """The ``sim`` backend: the MuJoCo board model behind the daemon loop, in real time.
 
 The same `daemon.sim.board_model.BoardModel` that ``validate-plan`` steps in lock-step: its
-physics runs at its own rate (2.5 ms, two steps per 5 ms tick), the control law at the
+physics runs at its own rate (1.25 ms, four steps per 5 ms tick), the control law at the
 loop's 200 Hz. The loop's absolute deadlines make it real time: each tick,
 ``step(dt)`` integrates the ``dt`` of wall-clock time since the last tick with the last
 commands (one board tick per 5 ms; after an overrun the missed ticks too, up to

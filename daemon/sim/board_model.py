@@ -4,10 +4,14 @@ This is the daemon's ``sim`` backend and what ``validate-plan`` steps in lock-st
 takes the control law's output each 5 ms tick (`daemon.joint_control.ControlOutput`) and
 advances the physics by one tick.
 
-Time step. The robot model's 2 ms does not divide the 5 ms tick; we use
-``physics_dt_s = 2.5 ms`` and two physics steps per tick. The boards update their motors
-every physics step (the JMC's loop runs faster than the daemon's, as here), the daemon's
-references and duties change once per tick.
+Time step: ``physics_dt_s = 1.25 ms``, four physics steps per 5 ms tick. The boards
+update their motors every physics step (the JMC's loop runs faster than the daemon's, as
+here), the daemon's references and duties change once per tick. The step comes from a
+convergence test on the stance feet (docs/decisions/physics-timestep.md): at 2.5 ms the
+soles on `stair`'s rung 0 crept 1.0 cm in 50 s, at 1.25 ms 0.2 cm, and that creep had
+ended 4 of 10 `stair` climbs 3–4 cm off their final holds. A sliding block creeps alike
+at either step, so the creep was the closed loop's dynamics not resolved, not MuJoCo's
+soft friction as such.
 
 Actuation, per joint, two MuJoCo actuators on the same hinge:
 
@@ -19,7 +23,8 @@ Actuation, per joint, two MuJoCo actuators on the same hinge:
   from the change of the sent reference over the tick); without it the loop would lag a
   moving reference by ``kv/kp`` ≈ 20 ms. We keep
   it inside MuJoCo rather than computing it in numpy because ``implicitfast`` then
-  integrates its damping implicitly, which keeps a stiff geared joint stable at 2.5 ms.
+  integrates its damping implicitly, which keeps a stiff geared joint stable (it was at
+  2.5 ms too).
 - *PWM* (added here, ``<joint>_pwm``): an affine actuator that is the DC-motor model of
   `robot.motors`: ``τ = g·duty − b·q̇`` with ``g = −η·gear·Kt·V/(100·R)`` and
   ``b = η·gear²·Kt·Ke/R``; the battery voltage ``V`` scales ``g``. The back-EMF damping
@@ -113,7 +118,7 @@ class BoardModelConfig:
     """
 
     battery_v: float = DEFAULT_BATTERY_V
-    physics_dt_s: float = 0.0025
+    physics_dt_s: float = 0.00125
     trip: BoardTripConfig = field(default_factory=BoardTripConfig)
     grip: GripConfig = field(default_factory=GripConfig)
 
@@ -127,7 +132,7 @@ class BoardModelConfig:
 
 
 def default_config() -> BoardModelConfig:
-    """48 V, 2.5 ms physics, 0.5 s trips, the grip of `daemon.sim.grasp_latch`."""
+    """48 V, 1.25 ms physics, 0.5 s trips, the grip of `daemon.sim.grasp_latch`."""
     return BoardModelConfig()
 
 
