@@ -8,10 +8,8 @@ Time step: ``physics_dt_s = 1.25 ms``, four physics steps per 5 ms tick. The boa
 update their motors every physics step (the JMC's loop runs faster than the daemon's, as
 here), the daemon's references and duties change once per tick. The step comes from a
 convergence test on the stance feet (docs/decisions/physics-timestep.md): at 2.5 ms the
-soles on `stair`'s rung 0 crept 1.0 cm in 50 s, at 1.25 ms 0.2 cm, and that creep had
-ended 4 of 10 `stair` climbs 3–4 cm off their final holds. A sliding block creeps alike
-at either step, so the creep was the closed loop's dynamics not resolved, not MuJoCo's
-soft friction as such.
+soles on `stair`'s rung 0 crept 1.0 cm in 50 s, at 1.25 ms and at 0.625 ms 0.1 cm or
+less.
 
 Actuation, per joint, two MuJoCo actuators on the same hinge:
 
@@ -23,8 +21,7 @@ Actuation, per joint, two MuJoCo actuators on the same hinge:
   from the change of the sent reference over the tick); without it the loop would lag a
   moving reference by ``kv/kp`` ≈ 20 ms. We keep
   it inside MuJoCo rather than computing it in numpy because ``implicitfast`` then
-  integrates its damping implicitly, which keeps a stiff geared joint stable (it was at
-  2.5 ms too).
+  integrates its damping implicitly, which keeps a stiff geared joint stable.
 - *PWM* (added here, ``<joint>_pwm``): an affine actuator that is the DC-motor model of
   `robot.motors`: ``τ = g·duty − b·q̇`` with ``g = −η·gear·Kt·V/(100·R)`` and
   ``b = η·gear²·Kt·Ke/R``; the battery voltage ``V`` scales ``g``. The back-EMF damping
