@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import itertools
 import sys
-import threading
 import time
 
 import can
@@ -117,12 +116,10 @@ def test_board_command_frames(rig):
     assert [bytes(m.data) for m in msgs] == [bytes([rkn.jmc, 0x11, rkn.mot_no + 1])]
 
 
-def _run_loop(loop, seconds, stop=None):
-    stop = stop or threading.Event()
-    t = threading.Timer(seconds, stop.set)
-    t.start()
-    loop.run(stop=stop)
-    t.cancel()
+def _run_ticks(loop, n_ticks):
+    """Run the loop for ``n_ticks`` more ticks: counted, not timed, so a loaded machine
+    (a late tick is skipped, not run) does not shorten the test's window."""
+    loop.run(max_ticks=loop.stats.ticks + n_ticks)
 
 
 def test_encoders_follow_and_a_silent_board_is_flagged_not_fatal(rig):
@@ -138,7 +135,7 @@ def test_encoders_follow_and_a_silent_board_is_flagged_not_fatal(rig):
     r["ref"][JOINT_INDEX["LEB"]] = -0.4
     r["mode"][:] = 1  # direct
     w.ref.write(r)
-    _run_loop(loop, 0.8)
+    _run_ticks(loop, 160)
     s = loop.state
     assert s["pos"][JOINT_INDEX["RKN"]] == pytest.approx(0.5, abs=0.01)
     assert s["pos"][JOINT_INDEX["LEB"]] == pytest.approx(-0.4, abs=0.01)
@@ -146,9 +143,9 @@ def test_encoders_follow_and_a_silent_board_is_flagged_not_fatal(rig):
     # a late reply (a loaded machine) may flag a tick here and there, a silent board every one
     emu.silence(be.joints["RAP"].jmc, can_bus=0)
     ticks, misses = loop.stats.ticks, be.no_reply_ticks.copy()
-    _run_loop(loop, 0.3)
+    _run_ticks(loop, 60)
     n = loop.stats.ticks - ticks
-    assert n > 20  # the loop went on
+    assert n == 60  # the loop went on
     missed = be.no_reply_ticks - misses
     assert missed[rap] >= n - 2 and missed[rar] >= n - 2
     assert np.delete(missed, [rap, rar]).max() < n / 2
@@ -156,9 +153,9 @@ def test_encoders_follow_and_a_silent_board_is_flagged_not_fatal(rig):
     assert s["status"][rap] & int(StatusFlag.NO_REPLY) and not s["active"][rap]
     assert s["pos"][JOINT_INDEX["RKN"]] == pytest.approx(0.5, abs=0.01)
     emu.silence(be.joints["RAP"].jmc, can_bus=0, silent=False)
-    _run_loop(loop, 0.1)
+    _run_ticks(loop, 20)
     ticks, misses = loop.stats.ticks, be.no_reply_ticks.copy()
-    _run_loop(loop, 0.3)
+    _run_ticks(loop, 60)
     assert (be.no_reply_ticks - misses)[rap] < (loop.stats.ticks - ticks) / 2
 
 
