@@ -18,6 +18,7 @@ from __future__ import annotations
 import dataclasses
 import json
 
+import numpy as np
 import pytest
 
 from execute.validate.cli import main as validate_main
@@ -87,3 +88,75 @@ def test_a_foot_that_finds_no_rung_stops_the_climb_before_loading_it(mount):
     step = next(seg for seg in sc.segments if seg.phase == "limb"
                 and stop["limb"] in seg.moving_limbs)
     assert run.log.line_index.max() <= step.last_line - 1
+
+
+def _play_on_kinematic_robot(mount, press_n, press_from, press_ticks):
+    """The mount's motion layer on a robot that is only encoders and F/T sensors: the
+    joints are where the layer sent them, fingers stop on the rail, a held foot carries
+    300 N and a foot in the air reads its own weight, except that the left foot reads
+    ``press_n`` for ``press_ticks`` ticks once its step onto rung 0 is ``press_from`` of
+    the way through. Returns (layer, per-tick (line, left sole's reference relative to
+    the plan's, in the pelvis frame [m])), up to the end of that step."""
+    from daemon.structs import STATE_DTYPE, new_sample
+    from execute.motion.layer import MotionLayer
+    from execute.play.player import PlayerOptions, TrajectoryPlayer
+    from robot.joints import FINGER_JOINTS, JOINT_INDEX
+    from robot.kinematic_tree import finger_contact_curl_rad
+
+    sc = read_sidecar(sidecar_path(mount))
+    traj = read_trajectory(mount, sc.rate_hz)
+    ladder = load_ladder("drc")
+    step = next(seg for seg in sc.segments if seg.phase == "limb"
+                and seg.moving_limbs == ("left_foot",))
+    press_line = step.first_line - 1 + round(press_from * (step.last_line - step.first_line))
+    layer = MotionLayer(TrajectoryPlayer(traj, PlayerOptions(rate_hz=int(sc.rate_hz))),
+                        traj, sc, ladder)
+    frame = layer.model.chains["left_foot"].frame
+    fingers = [JOINT_INDEX[f] for side in FINGER_JOINTS for f in FINGER_JOINTS[side]]
+    curl = finger_contact_curl_rad(ladder.rail_radius_m)
+    ref, pressed, trace, t = traj[0].copy(), 0, [], 0.0
+    while layer._line < step.last_line - 1 and layer.stop is None and t < 400.0:
+        seg = sc.segments[int(layer._segment_of_line[layer._line])]
+        sample = new_sample(STATE_DTYPE)
+        sample["time_s"] = t
+        sample["pos"][:] = ref
+        sample["pos"][fingers] = np.minimum(ref[fingers], curl)
+        sample["imu"][0]["az"] = 9.81
+        for k, side in ((0, "right"), (1, "left")):
+            sample["ft"][k]["fz"] = 300.0 if f"{side}_foot" in seg.holds else -12.0
+        if layer._line >= press_line and pressed < press_ticks:
+            sample["ft"][1]["fz"] = press_n
+            pressed += 1
+        ref = layer.step(t, sample).ref_rad
+        line = layer._line
+        off = (layer.model.frame_in_pelvis(ref, frame)[:3, 3]
+               - layer.model.frame_in_pelvis(traj[line], frame)[:3, 3])
+        trace.append((line, off))
+        t += 0.005
+    return layer, trace
+
+
+def test_a_foot_pressed_from_above_on_its_way_backs_off_and_steps_on(mount):
+    """A swinging foot whose F/T reads a push from above (its toe rising under a rung)
+    stops, backs away from the ladder, rises from there and still lands on its hold."""
+    layer, trace = _play_on_kinematic_robot(mount, -80.0, 0.4, 10)
+    strikes = [e for e in layer.events if e.kind.value == "foot strike"]
+    assert len(strikes) == 1 and strikes[0].limb == "left_foot", layer.events
+    assert layer.stop is None
+    k = next(i for i, (line, _off) in enumerate(trace) if line + 1 >= strikes[0].line)
+    backoff_ticks = round(layer.config.strike_backoff_s / 0.005)
+    lines = [line for line, _off in trace[k: k + backoff_ticks]]
+    assert max(lines) - min(lines) <= 1  # the step waited while the foot backed off
+    away = trace[k + backoff_ticks][1]  # pelvis frame: x towards the ladder, z up
+    assert away[0] == pytest.approx(-layer.config.strike_backoff_m, abs=0.01)
+    assert away[2] < -0.005
+    assert np.linalg.norm(trace[-1][1]) < 0.005  # the step still ends on its hold
+
+
+def test_a_foot_still_pressed_after_its_back_offs_stops_the_climb(mount):
+    layer, trace = _play_on_kinematic_robot(mount, -80.0, 0.4, 100_000)
+    strikes = [e for e in layer.events if e.kind.value == "foot strike"]
+    assert len(strikes) == layer.config.strike_tries
+    assert strikes[1].size_m == pytest.approx(2 * layer.config.strike_backoff_m)
+    assert layer.stop is not None and layer.stop.cause.value == "foothold_unverified"
+    assert "pressed from above" in layer.stop.reason

@@ -187,7 +187,9 @@ def test_a_missed_grasp_searches_where_the_holding_hands_found_the_rails(reach):
                                          ("grasp_retries", -1),
                                          ("max_reach_correction_rad", 1.0),
                                          ("landing_reach_m", 0.10),
-                                         ("landing_load_n", 0.0)])
+                                         ("landing_load_n", 0.0),
+                                         ("strike_load_n", 5.0),
+                                         ("strike_backoff_m", 0.08)])
 def test_unsafe_settings_are_refused(field, value):
     with pytest.raises(MotionConfigError) as exc:
         MotionConfig(**{field: value})

@@ -50,6 +50,10 @@ _RANGES = {
     "landing_wait_s": (0.0, 5.0),
     "landing_reach_m": (0.0, 0.06),
     "landing_speed_m_s": (0.002, 0.05),
+    "strike_load_n": (15.0, 200.0),
+    "strike_backoff_m": (0.0, 0.06),
+    "strike_backoff_s": (0.1, 3.0),
+    "strike_tries": (0, 4),
 }
 
 
@@ -82,6 +86,12 @@ class MotionConfig:
         landing_reach_m: how far beyond its planned hold, down towards its rung, a foot
             may reach to find it [m].
         landing_speed_m_s: how fast it reaches [m/s].
+        strike_load_n: how far below zero a swinging foot's F/T load must fall to show
+            that something presses on the foot from above (its toe rising under a rung):
+            a foot in the air reads its own weight, about −12 N [N].
+        strike_backoff_m: how far such a foot backs away from the ladder, each time [m].
+        strike_backoff_s: how long the back-off takes, the player paused [s].
+        strike_tries: back-offs per step before the layer stops the climb.
         estimator: the state estimator's thresholds.
     """
 
@@ -102,6 +112,10 @@ class MotionConfig:
     landing_wait_s: float = 0.5
     landing_reach_m: float = 0.03
     landing_speed_m_s: float = 0.01
+    strike_load_n: float = 40.0
+    strike_backoff_m: float = 0.03
+    strike_backoff_s: float = 0.5
+    strike_tries: int = 2
     estimator: EstimatorConfig = field(default_factory=EstimatorConfig)
 
     def __post_init__(self) -> None:

@@ -1,5 +1,5 @@
 """What the motion layer did: one record per correction, grasp check, re-reach, foot
-landing or stop."""
+landing, foot strike or stop."""
 
 from __future__ import annotations
 
@@ -21,6 +21,7 @@ class MotionEventKind(enum.Enum):
     LEG_RELIEF = "leg relief"  #: the gripping arms began to lift more: a leg joint neared its limit
     LADDER_ESTIMATE = "ladder estimate"  #: the estimate of the ladder's pose changed
     FOOT_LANDING = "foot landing"  #: a step ended with its foot unloaded; it reached further
+    FOOT_STRIKE = "foot strike"  #: a swinging foot met something from above; it backed off
     STOP = "stop"  #: the layer holds the pose and stops the climb
 
 

@@ -25,6 +25,12 @@ hubo-motion-rt and the thesis's operator did (thesis §4.3.4, §6.2):
   foot's F/T sensor reads ``landing_load_n``; if it does not within ``landing_wait_s``, the
   foot reaches further down towards its rung, at ``landing_speed_m_s``, until it does, at
   most ``landing_reach_m``; then the layer **stops** as for a grasp;
+- **guarded swing**: a swinging foot whose F/T sensor reads a push from above (its toe
+  rising under the rung it steps onto, the body a few centimetres nearer the ladder than
+  planned) stops, the player paused, and backs away from the ladder by
+  ``strike_backoff_m``; it keeps that back-off while it rises, to the highest point of its
+  step, and reaches its hold from there. After ``strike_tries`` back-offs in one step the
+  layer **stops** as for a grasp;
 - **a guard on stiff arms**: a stiff arm that pushes near a torque limit complies again;
 - **wrist-roll relief** of a gripping arm (`execute.motion.wrist_relief`), from its motor
   current, while its fingers hold the rail;
@@ -84,6 +90,11 @@ SEARCH_PATTERN = ((1, 0), (0, 1), (0, -1), (-1, 0), (2, 0), (1, 1), (1, -1), (-2
 #: odometry drift, a hand settled off the axis within the grip) is below it, and the grip
 #: and the feet tolerate it.
 MIN_CORRECTION_M = 0.01
+#: The planned swing's highest point is looked for on every this many lines.
+APEX_STRIDE_LINES = 20
+#: A backing-off foot also moves down by this share of its back-off, off the underside it
+#: met.
+STRIKE_DOWN_SHARE = 1.0 / 3.0
 #: Two targets closer than this are the same [m].
 SAME_TARGET_M = 0.005
 #: A stiff arm whose motor currents say a joint has pushed harder than this share of its
@@ -142,6 +153,17 @@ class _Landing:
     reach_s: float = 0.0  # how long the full reach takes [s]
 
 
+@dataclass
+class _Strike:
+    """A swinging foot that met something from above, backing off while the player waits."""
+
+    side: str
+    segment: int
+    since_s: float
+    backoff_dq: np.ndarray  # the leg's joint offset once backed off [rad]
+    target_dq: np.ndarray  # the step's own correction at its last line [rad]
+
+
 class MotionLayer:
     """Closed-loop playback (module docstring).
 
@@ -195,6 +217,8 @@ class MotionLayer:
         self._regrasp: _Regrasp | None = None
         self._landing: _Landing | None = None
         self._landed: set[int] = set()  # steps whose foot landing has been checked
+        self._strike: _Strike | None = None
+        self._strikes: dict[int, int] = {}  # step segment → back-offs so far
         self._open_fingers: set[str] = set()
         self._stiff_arms: set[str] = set()  # arms held in position mode until they grip
         self._yielded: set[str] = set()  # stiff arms that pushed on something, until they grip
@@ -614,6 +638,81 @@ class MotionLayer:
         self._event(MotionEventKind.STOP, f"{f.side}_foot", reached_m, reason)
         self._landing = None
 
+    # ------------------------------------------------------------------ swing strikes
+    def _strike_due(self, line_index: int, s: SensedState) -> _Strike | None:
+        """A foot in the middle of its step whose F/T sensor reads a push from above:
+        start its back-off (or stop the climb once its step has used its back-offs)."""
+        k = int(self._segment_of_line[line_index])
+        seg = self.sidecar.segments[k]
+        if seg.phase != "limb" or line_index >= seg.last_line - 1:
+            return None  # the step's end is the guarded landing's
+        cfg = self.config
+        for limb in seg.moving_limbs:
+            if not limb.endswith("_foot"):
+                continue
+            side = _side(limb)
+            load = s.foot_load_n(side)
+            if load > -cfg.strike_load_n:
+                continue
+            tries = self._strikes.get(k, 0)
+            target = self._next_hold[k].get(limb, (k, None))[1]
+            rung = target.target if target is not None else "its hold"
+            if tries >= cfg.strike_tries:
+                reason = (f"{limb} was pressed from above ({load:.0f} N on its F/T) on its "
+                          f"way to {rung} after {tries} back-off{'s' if tries != 1 else ''}: "
+                          "the step was not finished and no weight moved onto it")
+                self.stop = MotionStop(self._now, line_index + 1, limb, reason,
+                                       FailureCause.FOOTHOLD_UNVERIFIED, tries, {"rung": rung})
+                self._event(MotionEventKind.STOP, limb, 0.0, reason)
+                return None
+            self._strikes[k] = tries + 1
+            away = -self.geometry.ladder_direction.copy()
+            away[2] = 0.0
+            away /= float(np.linalg.norm(away))
+            backoff = cfg.strike_backoff_m * (tries + 1)
+            shift = (self._shift_m.get(limb, np.zeros(3)) + backoff * away
+                     + [0.0, 0.0, -STRIKE_DOWN_SHARE * backoff])
+            backoff_dq, _residual = self._limb_shift_dq(limb, line_index, shift)
+            blend = self._offsets.get(limb)
+            current = (np.zeros_like(backoff_dq) if blend is None else
+                       blend.at(self._now if blend.time_based else float(line_index)))
+            # the step's own correction, reached at its last line (a first strike finds it
+            # as the reach correction's blend; a later one as the last strike's)
+            target_dq = blend.end if blend is not None else np.zeros_like(backoff_dq)
+            self._offsets[limb] = _Blend(current, backoff_dq, self._now,
+                                         self._now + cfg.strike_backoff_s, time_based=True)
+            self._event(MotionEventKind.FOOT_STRIKE, limb, backoff,
+                        f"its F/T read {load:.0f} N (a foot in the air reads about −12 N): "
+                        f"something presses on it from above on its way to {rung}; it backs "
+                        f"{backoff * 100:.0f} cm away from the ladder and rises from there")
+            return _Strike(side, k, self._now, backoff_dq, target_dq)
+        return None
+
+    def _update_strike(self) -> None:
+        """Once the foot has backed off, go on: it keeps the back-off up to the highest
+        point of its planned step, and reaches its hold from there."""
+        f = self._strike
+        if self._now < f.since_s + self.config.strike_backoff_s:
+            return
+        seg = self.sidecar.segments[f.segment]
+        limb = f"{f.side}_foot"
+        apex = self._apex_line(limb, self._line, seg.last_line - 1)
+        self._offsets[limb] = _Blend(f.backoff_dq, f.target_dq, float(apex),
+                                     float(seg.last_line - 1))
+        self._strike = None
+        self.player.resume(self._now)
+
+    def _apex_line(self, limb: str, first: int, last: int) -> int:
+        """The line in [first, last] where the plan has ``limb`` highest (world, at the
+        body's sensed tilt)."""
+        frame = self.model.chains[limb].frame
+        lines = np.arange(first, last + 1, APEX_STRIDE_LINES)
+        up_in_pelvis = self.estimate.R_tilt[2]  # the world's z axis, in the pelvis frame
+        heights = [float(up_in_pelvis @ self.model.frame_in_pelvis(self.trajectory_rad[line],
+                                                                   frame)[:3, 3])
+                   for line in lines]
+        return int(lines[int(np.argmax(heights))])
+
     # ------------------------------------------------------------------ the tick
     def step(self, now_s: float, state_sample: np.ndarray) -> PlayerTick:
         """The command of the tick at ``now_s``, from the daemon's state sample."""
@@ -628,21 +727,26 @@ class MotionLayer:
             self._update_regrasp(s)
         elif self._landing is not None:
             self._update_landing(s)
+        elif self._strike is not None:
+            self._update_strike()
         tick = self.player.step(now_s, s.pos_rad)
         self._line = tick.line_index
         k = int(self._segment_of_line[tick.line_index])
         if k != self._segment and not tick.going_to_init:
             self._segment = k
             self._enter_segment(k)
-        if self._regrasp is None and self._landing is None and self.stop is None \
-                and not tick.going_to_init:
+        if self._regrasp is None and self._landing is None and self._strike is None \
+                and self.stop is None and not tick.going_to_init:
             due = self._grasp_due(tick.line_index)
             if due is not None:
                 self._regrasp = due
                 self.player.pause(now_s)
             else:
                 self._landing = self._landing_due(tick.line_index, s)
-                if self._landing is not None:
+                if self._landing is None:
+                    self._strike = self._strike_due(tick.line_index, s)
+                if self._landing is not None or self._strike is not None \
+                        or self.stop is not None:
                     self.player.pause(now_s)
         return self._command(tick, s, dt)
 
