@@ -112,9 +112,9 @@ class MotionConfig:
     landing_wait_s: float = 0.5
     landing_reach_m: float = 0.03
     landing_speed_m_s: float = 0.01
-    strike_load_n: float = 40.0
+    strike_load_n: float = 30.0
     strike_backoff_m: float = 0.03
-    strike_backoff_s: float = 0.5
+    strike_backoff_s: float = 0.3
     strike_tries: int = 2
     estimator: EstimatorConfig = field(default_factory=EstimatorConfig)
 
