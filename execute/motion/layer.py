@@ -125,6 +125,10 @@ class _Blend:
             return self.end
         return self.start + min_jerk((t - self.t0) / (self.t1 - self.t0)) * (self.end - self.start)
 
+    def on_tick(self, now_s: float, line_index: int) -> np.ndarray:
+        """The offset on a tick: at its time or at its line, whichever the blend runs on."""
+        return self.at(now_s if self.time_based else float(line_index))
+
 
 @dataclass
 class _Regrasp:
@@ -267,9 +271,10 @@ class MotionLayer:
         self.events.append(ev)
 
     # ------------------------------------------------------------------ offsets
-    def _offset(self, limb: str, t: float) -> np.ndarray | None:
+    def _offset(self, limb: str) -> np.ndarray | None:
+        """``limb``'s joint offset on this tick, None without one."""
         blend = self._offsets.get(limb)
-        return None if blend is None else blend.at(t)
+        return None if blend is None else blend.on_tick(self._now, self._line)
 
     def _limb_shift_dq(self, limb: str, line_index: int, shift_world_m: np.ndarray
                        ) -> tuple[np.ndarray, float]:
@@ -331,7 +336,7 @@ class MotionLayer:
         for limb, (_j, hold) in self._next_hold[k].items():
             if seg.phase != "limb" or not self._on_ladder(hold.target):
                 continue
-            current = self._offset(limb, float(self._line))
+            current = self._offset(limb)
             shift = self._ladder_shift(np.asarray(hold.position_m))
             if not shift.any():
                 if current is None:
@@ -416,7 +421,7 @@ class MotionLayer:
         """Blend the hand's offset to one that moves it by ``shift`` [m], over shift_s."""
         limb = f"{g.side}_hand"
         dq, residual = self._limb_shift_dq(limb, self._line, shift)
-        current = self._offset(limb, float(self._line))
+        current = self._offset(limb)
         self._offsets[limb] = _Blend(current if current is not None else np.zeros_like(dq),
                                      dq, self._now, self._now + self.config.shift_s,
                                      time_based=True)
@@ -611,7 +616,7 @@ class MotionLayer:
             # from where the step's own correction put the foot, straight down
             down = self._shift_m.get(limb, np.zeros(3)) + [0.0, 0.0, -cfg.landing_reach_m]
             dq, _residual = self._limb_shift_dq(limb, self._line, down)
-            current = self._offset(limb, float(self._line))
+            current = self._offset(limb)
             f.reach_s = cfg.landing_reach_m / cfg.landing_speed_m_s
             self._offsets[limb] = _Blend(current if current is not None else np.zeros_like(dq),
                                          dq, now, now + f.reach_s, time_based=True)
@@ -633,10 +638,14 @@ class MotionLayer:
         reason = (f"{f.side}_foot found no rung: its F/T read {load_n:.0f} N after reaching "
                   f"{reached_m * 100:.0f} cm below its planned hold on {f.target}: the weight "
                   "was not moved onto it")
-        self.stop = MotionStop(self._now, self._line + 1, f"{f.side}_foot", reason,
-                               FailureCause.FOOTHOLD_UNVERIFIED, 0, {"rung": f.target})
-        self._event(MotionEventKind.STOP, f"{f.side}_foot", reached_m, reason)
+        self._stop_step(f"{f.side}_foot", f.target, reason, 0, reached_m)
         self._landing = None
+
+    def _stop_step(self, limb: str, rung: str, reason: str, tries: int, size_m: float) -> None:
+        """Stop the climb on a step its foot could not finish; no weight moved onto it."""
+        self.stop = MotionStop(self._now, self._line + 1, limb, reason,
+                               FailureCause.FOOTHOLD_UNVERIFIED, tries, {"rung": rung})
+        self._event(MotionEventKind.STOP, limb, size_m, reason)
 
     # ------------------------------------------------------------------ swing strikes
     def _strike_due(self, line_index: int, s: SensedState) -> _Strike | None:
@@ -661,21 +670,16 @@ class MotionLayer:
                 reason = (f"{limb} was pressed from above ({load:.0f} N on its F/T) on its "
                           f"way to {rung} after {tries} back-off{'s' if tries != 1 else ''}: "
                           "the step was not finished and no weight moved onto it")
-                self.stop = MotionStop(self._now, line_index + 1, limb, reason,
-                                       FailureCause.FOOTHOLD_UNVERIFIED, tries, {"rung": rung})
-                self._event(MotionEventKind.STOP, limb, 0.0, reason)
+                self._stop_step(limb, rung, reason, tries, 0.0)
                 return None
             self._strikes[k] = tries + 1
-            away = -self.geometry.ladder_direction.copy()
-            away[2] = 0.0
-            away /= float(np.linalg.norm(away))
+            away = -self.geometry.R_world_ladder[:, 0]  # horizontal, from the ladder
             backoff = cfg.strike_backoff_m * (tries + 1)
             shift = (self._shift_m.get(limb, np.zeros(3)) + backoff * away
                      + [0.0, 0.0, -STRIKE_DOWN_SHARE * backoff])
             backoff_dq, _residual = self._limb_shift_dq(limb, line_index, shift)
             blend = self._offsets.get(limb)
-            current = (np.zeros_like(backoff_dq) if blend is None else
-                       blend.at(self._now if blend.time_based else float(line_index)))
+            current = np.zeros_like(backoff_dq) if blend is None else self._offset(limb)
             # the step's own correction, reached at its last line (a first strike finds it
             # as the reach correction's blend; a later one as the last strike's)
             target_dq = blend.end if blend is not None else np.zeros_like(backoff_dq)
@@ -756,8 +760,7 @@ class MotionLayer:
         plan_rad = tick.ref_rad
         ref = plan_rad.copy()
         for blend in self._offsets.values():
-            t = self._now if blend.time_based else float(tick.line_index)
-            ref += blend.at(t)
+            ref += blend.on_tick(self._now, tick.line_index)
         for side in self._open_fingers:
             ref[self._finger_cols[side]] = 0.0
         self._last_ref = ref
