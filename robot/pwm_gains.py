@@ -30,6 +30,7 @@ __all__ = [
     "PWM_COMMAND_LIMIT_PCT",
     "SAFE_KP",
     "SAFE_MAX_PWM_PCT",
+    "climbing_gain_table",
     "safe_default_gain_table",
 ]
 
@@ -77,3 +78,24 @@ def safe_default_gain_table() -> dict[str, tuple[float, float, float]]:
     """
     return {name: (min(kp, SAFE_KP), kd, min(max_pwm, SAFE_MAX_PWM_PCT))
             for name, (kp, kd, max_pwm) in DRC_DOCUMENTED_GAINS.items()}
+
+
+def climbing_gain_table(max_pwm_pct: float = SAFE_MAX_PWM_PCT
+                        ) -> dict[str, tuple[float, float, float]]:
+    """The gains a compliant arm climbs with, joint → (kp, kd, max_pwm %).
+
+    hubo-ach's documented defaults clamp the elbows and wrists at 4–5 % of duty: a wrist
+    pitch then gives at most 1.4 N·m, less than a gripping hand needs, and DRC grips bent
+    open (docs/decisions/motion-layer.md). hubo-motion-rt ran its arms with gains of its
+    own for the same reason. Here every arm joint that has a clamp gets ``max_pwm_pct``
+    (never below its default; whoever loads the table into the daemon checks it against
+    the safety limits, `daemon.pwm.PwmGains`); kp and kd stay the safe defaults. The
+    motion layer drives the arms with these (`execute.motion.gains`), and the planner
+    times a gripping arm's motion by the speed they can follow
+    (`planner.statics.arm_capacity.compliant_speed_rad_s`).
+    """
+    table = safe_default_gain_table()
+    for name, (kp, kd, clamp) in table.items():
+        if clamp > 0.0:
+            table[name] = (kp, kd, max(clamp, max_pwm_pct))
+    return table

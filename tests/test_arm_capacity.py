@@ -19,6 +19,8 @@ from planner.statics.torque_lp import torque_feasibility, torque_limits_by_joint
 from primitives.library import climb_sequence
 from robot.joints import ARM_JOINTS, JOINT_INDEX
 from robot.limits import joint_limits
+from robot.motors import DEFAULT_BATTERY_V, motor_table
+from robot.pwm_gains import climbing_gain_table, safe_default_gain_table
 
 
 def _stall_nm(kt, r_ohm, gear, duty_pct, volts=48.0, eta=0.7):
@@ -77,6 +79,22 @@ def test_compliant_speed_leaves_the_load_three_quarters_of_the_clamp():
                                          / b_shoulder, rel=1e-9)
     assert speed["LSP"] == pytest.approx(0.063, abs=1e-3)  # rad/s, against 1 nominal
     assert "LWR" not in speed  # the wrist roll is never compliant
+
+
+def test_an_elbow_and_a_wrist_follow_the_body_at_their_climbing_clamp():
+    """The motion layer climbs with the elbows' and wrists' clamps at 7.9 % (4–5 % by
+    default): they may follow the body that much faster, and the load the planner gives
+    them (the default clamp's torque) still fits beside the back-EMF."""
+    speed, load = compliant_speed_rad_s(), compliant_torque_nm()
+    climbing, default = climbing_gain_table(), safe_default_gain_table()
+    per_duty = np.abs(motor_table().torque_per_duty(DEFAULT_BATTERY_V))
+    damping = motor_table().back_emf_damping
+    for name in ("LEB", "REB", "LWP", "RWY"):
+        j = JOINT_INDEX[name]
+        assert climbing[name][2] == pytest.approx(7.9) and default[name][2] <= 5.0
+        assert speed[name] == pytest.approx(BACK_EMF_SHARE * per_duty[j] * 7.9 / damping[j])
+        back_emf_nm = damping[j] * speed[name]
+        assert load[name] + back_emf_nm <= per_duty[j] * climbing[name][2] + 1e-9
 
 
 def test_velocity_limits_cap_only_the_compliant_joints_of_holding_arms():

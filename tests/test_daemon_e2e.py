@@ -250,8 +250,11 @@ def test_faults_player_killed_two_writers_and_a_daemon_restart(plan, tmp_path):
         d.wait_until(lambda s: s["ref"][JOINT_INDEX["LSR"]] > 0.3, timeout_s=30)
         p.kill()  # SIGKILL mid-reach: the player cannot say goodbye
         p.wait()
-        d.wait_until(lambda s: True)
-        time.sleep(1.0)
+        # the watchdog (0.2 s = 40 ticks) and the 150-tick hold checked below pass before
+        # the two writers start: counted in the daemon's ticks, which a loaded machine
+        # slows (in wall time the writers' step once fell inside the hold)
+        tick0 = int(d.wait_until(lambda s: True)["tick"])
+        d.wait_until(lambda s: int(s["tick"]) > tick0 + 250, timeout_s=60)
         # two writers on ref: the newest sample wins, whoever wrote it
         a = open_channel("ref", d.instance, writer_id=101)
         b = open_channel("ref", d.instance, writer_id=102)

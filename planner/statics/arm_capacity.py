@@ -26,7 +26,7 @@ import numpy as np
 from planner.contacts import Stance
 from robot.joints import ARM_JOINTS, JOINT_INDEX
 from robot.motors import DEFAULT_BATTERY_V, motor_table
-from robot.pwm_gains import safe_default_gain_table
+from robot.pwm_gains import climbing_gain_table, safe_default_gain_table
 from robot.vocabulary import ArmStrategy
 
 __all__ = ["ARM_STRATEGIES", "BACK_EMF_SHARE", "DEFAULT_ARM_STRATEGY",
@@ -88,12 +88,24 @@ def compliant_torque_nm(battery_v: float = DEFAULT_BATTERY_V) -> Mapping[str, fl
 
 @lru_cache(maxsize=16)
 def compliant_speed_rad_s(battery_v: float = DEFAULT_BATTERY_V) -> Mapping[str, float]:
-    """Speed at which a compliant joint's back-EMF takes `BACK_EMF_SHARE` of its PWM
-    clamp, ``share · τ_clamp / b`` (b: back-EMF damping, `robot.motors`) [rad/s]."""
+    """Speed at which a compliant joint's back-EMF takes `BACK_EMF_SHARE` of the PWM clamp
+    it climbs with, ``share · τ_clamp / b`` (b: back-EMF damping, `robot.motors`;
+    the clamp of `robot.pwm_gains.climbing_gain_table`, which the motion layer drives the
+    arms with) [rad/s].
+
+    The load the planner gives a compliant arm stays within the documented defaults'
+    clamp (`compliant_torque_nm`). On the elbows and wrists (4–5 %) the climbing clamp,
+    7.9 %, holds that load and the back-EMF together; the shoulders' default clamp is
+    already the safety ceiling, and their speed is what it was. Timed by the defaults'
+    clamp, a gripping elbow followed the body at 0.04 rad/s and one
+    DRC step lasted 69 s (docs/decisions/arm-speed.md).
+    """
+    per_duty = np.abs(motor_table().torque_per_duty(battery_v))
     damping = motor_table().back_emf_damping
     return MappingProxyType({
-        name: BACK_EMF_SHARE * torque / float(damping[JOINT_INDEX[name]])
-        for name, torque in compliant_torque_nm(battery_v).items()})
+        name: BACK_EMF_SHARE * float(per_duty[JOINT_INDEX[name]]) * max_pwm
+        / float(damping[JOINT_INDEX[name]])
+        for name, (_, _, max_pwm) in climbing_gain_table().items() if max_pwm > 0})
 
 
 def gripping_velocity_limits(nominal_rad_s: np.ndarray, sides: Iterable[str],
