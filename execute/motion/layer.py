@@ -271,10 +271,12 @@ class MotionLayer:
         self.events.append(ev)
 
     # ------------------------------------------------------------------ offsets
-    def _offset(self, limb: str) -> np.ndarray | None:
-        """``limb``'s joint offset on this tick, None without one."""
+    def _offset(self, limb: str) -> np.ndarray:
+        """``limb``'s joint offset on this tick; zero without one (where a new blend
+        starts)."""
         blend = self._offsets.get(limb)
-        return None if blend is None else blend.on_tick(self._now, self._line)
+        return np.zeros(len(JOINT_NAMES)) if blend is None else blend.on_tick(self._now,
+                                                                              self._line)
 
     def _limb_shift_dq(self, limb: str, line_index: int, shift_world_m: np.ndarray
                        ) -> tuple[np.ndarray, float]:
@@ -336,16 +338,15 @@ class MotionLayer:
         for limb, (_j, hold) in self._next_hold[k].items():
             if seg.phase != "limb" or not self._on_ladder(hold.target):
                 continue
-            current = self._offset(limb)
             shift = self._ladder_shift(np.asarray(hold.position_m))
             if not shift.any():
-                if current is None:
+                if limb not in self._offsets:
                     continue
-                dq, residual = np.zeros_like(current), 0.0
+                dq, residual = np.zeros(len(JOINT_NAMES)), 0.0
             else:
                 dq, residual = self._limb_shift_dq(limb, seg.last_line - 1, shift)
-            start = current if current is not None else np.zeros_like(dq)
-            self._offsets[limb] = _Blend(start, dq, float(seg.first_line - 1),
+            self._offsets[limb] = _Blend(self._offset(limb), dq,
+                                         float(seg.first_line - 1),
                                          float(seg.last_line - 1))
             self._shift_m[limb] = shift
             self._event(MotionEventKind.REACH_CORRECTION, limb, float(np.linalg.norm(shift)),
@@ -421,9 +422,8 @@ class MotionLayer:
         """Blend the hand's offset to one that moves it by ``shift`` [m], over shift_s."""
         limb = f"{g.side}_hand"
         dq, residual = self._limb_shift_dq(limb, self._line, shift)
-        current = self._offset(limb)
-        self._offsets[limb] = _Blend(current if current is not None else np.zeros_like(dq),
-                                     dq, self._now, self._now + self.config.shift_s,
+        self._offsets[limb] = _Blend(self._offset(limb), dq, self._now,
+                                     self._now + self.config.shift_s,
                                      time_based=True)
         self._shift_m[limb] = shift
         kind = MotionEventKind.RE_REACH if g.tries else MotionEventKind.REACH_CORRECTION
@@ -616,10 +616,9 @@ class MotionLayer:
             # from where the step's own correction put the foot, straight down
             down = self._shift_m.get(limb, np.zeros(3)) + [0.0, 0.0, -cfg.landing_reach_m]
             dq, _residual = self._limb_shift_dq(limb, self._line, down)
-            current = self._offset(limb)
             f.reach_s = cfg.landing_reach_m / cfg.landing_speed_m_s
-            self._offsets[limb] = _Blend(current if current is not None else np.zeros_like(dq),
-                                         dq, now, now + f.reach_s, time_based=True)
+            self._offsets[limb] = _Blend(self._offset(limb), dq, now, now + f.reach_s,
+                                         time_based=True)
             f.phase, f.since_s = "reach", now
             self._event(MotionEventKind.FOOT_LANDING, limb, 0.0,
                         f"the step ended with the foot's F/T at {load:.0f} N (standing: "
@@ -679,11 +678,10 @@ class MotionLayer:
                      + [0.0, 0.0, -STRIKE_DOWN_SHARE * backoff])
             backoff_dq, _residual = self._limb_shift_dq(limb, line_index, shift)
             blend = self._offsets.get(limb)
-            current = np.zeros_like(backoff_dq) if blend is None else self._offset(limb)
             # the step's own correction, reached at its last line (a first strike finds it
             # as the reach correction's blend; a later one as the last strike's)
             target_dq = blend.end if blend is not None else np.zeros_like(backoff_dq)
-            self._offsets[limb] = _Blend(current, backoff_dq, self._now,
+            self._offsets[limb] = _Blend(self._offset(limb), backoff_dq, self._now,
                                          self._now + cfg.strike_backoff_s, time_based=True)
             self._event(MotionEventKind.FOOT_STRIKE, limb, backoff,
                         f"its F/T read {load:.0f} N (a foot in the air reads about −12 N): "

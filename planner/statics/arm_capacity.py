@@ -77,13 +77,18 @@ def balance_stance(stance: Stance, strategy: str = DEFAULT_ARM_STRATEGY) -> Stan
     return Stance(feet)
 
 
+def _clamp_torque_nm(gains: Mapping[str, tuple[float, float, float]],
+                     battery_v: float) -> dict[str, float]:
+    """Stall torque at each clamped joint's PWM clamp in ``gains`` [N·m]."""
+    per_duty = np.abs(motor_table().torque_per_duty(battery_v))
+    return {name: float(per_duty[JOINT_INDEX[name]] * max_pwm)
+            for name, (_, _, max_pwm) in gains.items() if max_pwm > 0}
+
+
 @lru_cache(maxsize=16)
 def compliant_torque_nm(battery_v: float = DEFAULT_BATTERY_V) -> Mapping[str, float]:
     """Stall torque at the default gains' PWM clamp, per compliant joint [N·m]."""
-    per_duty = np.abs(motor_table().torque_per_duty(battery_v))
-    return MappingProxyType({
-        name: float(per_duty[JOINT_INDEX[name]] * max_pwm)
-        for name, (_, _, max_pwm) in safe_default_gain_table().items() if max_pwm > 0})
+    return MappingProxyType(_clamp_torque_nm(safe_default_gain_table(), battery_v))
 
 
 @lru_cache(maxsize=16)
@@ -100,12 +105,10 @@ def compliant_speed_rad_s(battery_v: float = DEFAULT_BATTERY_V) -> Mapping[str, 
     clamp, a gripping elbow followed the body at 0.04 rad/s and one
     DRC step lasted 69 s (docs/decisions/arm-speed.md).
     """
-    per_duty = np.abs(motor_table().torque_per_duty(battery_v))
     damping = motor_table().back_emf_damping
     return MappingProxyType({
-        name: BACK_EMF_SHARE * float(per_duty[JOINT_INDEX[name]]) * max_pwm
-        / float(damping[JOINT_INDEX[name]])
-        for name, (_, _, max_pwm) in climbing_gain_table().items() if max_pwm > 0})
+        name: BACK_EMF_SHARE * torque / float(damping[JOINT_INDEX[name]])
+        for name, torque in _clamp_torque_nm(climbing_gain_table(), battery_v).items()})
 
 
 def gripping_velocity_limits(nominal_rad_s: np.ndarray, sides: Iterable[str],
