@@ -147,6 +147,22 @@ def test_tripped_board_has_no_torque(board):
     board.reset()
 
 
+def test_the_gyros_read_their_bias(board):
+    """MuJoCo's gyro is exact; the simulated one reads the configured bias on top."""
+    from daemon.sim.sensors import SensorIndex, read_sensors
+
+    board.reset()
+    board.step()
+    index = SensorIndex(board.model)
+    bias = np.asarray(board.config.gyro_bias_rad_s)
+    assert np.abs(bias).max() > 0.0
+    exact = read_sensors(board.data, index).imu
+    biased = read_sensors(board.data, index, bias).imu
+    assert np.allclose(biased[:, 3:] - exact[:, 3:], bias)
+    assert np.array_equal(biased[:, :3], exact[:, :3])
+    assert np.allclose(board.state().sensors.imu, biased)
+
+
 def test_sensors_in_state_units(board):
     board.reset()
     ctl = JointController()

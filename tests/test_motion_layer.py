@@ -91,6 +91,55 @@ def test_the_estimator_runs_on_the_state_struct_alone():
         SensedState.from_sample(np.zeros(3))
 
 
+def _standing_sample(model: MotionRobotModel, time_s: float, gyro_z_rad_s: float) -> SensedState:
+    """Both feet carrying half the weight in the zero pose, the body IMU's gyro reading
+    ``gyro_z_rad_s`` about the pelvis's z."""
+    sample = new_sample(STATE_DTYPE)
+    sample["time_s"] = time_s
+    sample["imu"][0]["az"] = 9.81
+    sample["imu"][0]["wz"] = gyro_z_rad_s
+    for k in (0, 1):
+        sample["ft"][k]["fz"] = 0.5 * model.mass_kg * 9.81
+    return SensedState.from_sample(sample)
+
+
+def _heading_rad(T: np.ndarray) -> float:
+    return float(np.arctan2(T[1, 0], T[0, 0]))
+
+
+STANDING_SOLES = {"left": np.array([0.0, 0.0885, 0.0]), "right": np.array([0.0, -0.0885, 0.0])}
+
+
+def test_the_estimator_sees_a_stance_that_turns_on_its_feet():
+    """Leg odometry cannot see a body that turns with its standing feet (the encoders do
+    not move); the gyro does, and the feet are anchored again at its heading."""
+    model = MotionRobotModel()
+    est = StateEstimator(model, STANDING_SOLES)
+    rate = 0.02  # [rad/s] for 3 s: 3.4°, as the body turned on `ship` while a hand reached
+    for k in range(601):
+        e = est.update(_standing_sample(model, k * 0.005, rate if k else 0.0))
+    assert _heading_rad(e.T_world_pelvis) == pytest.approx(0.06, abs=0.006)
+    assert est.foot_turns > 0
+    # two standing feet turn about the point between them, which stays where they landed
+    mid = 0.5 * (e.sole_m["left"] + e.sole_m["right"])
+    assert np.allclose(mid, 0.0, atol=1e-3)
+    across = e.sole_m["left"] - e.sole_m["right"]
+    assert float(np.arctan2(-across[0], across[1])) == pytest.approx(0.06, abs=0.006)
+
+
+def test_the_estimator_learns_the_gyros_bias_from_feet_that_stand_still():
+    """A gyro that reads 20°/h at rest: the heading stays with the standing feet, within
+    the turn that anchors a foot again, and the bias is learnt."""
+    model = MotionRobotModel()
+    est = StateEstimator(model, STANDING_SOLES)
+    bias = 1e-4  # [rad/s]
+    headings = [_heading_rad(est.update(_standing_sample(model, k * 0.05, bias)).T_world_pelvis)
+                for k in range(4001)]  # 200 s at 20 Hz
+    assert max(abs(h) for h in headings) < est.config.foot_turn_rad
+    assert est.foot_turns == 0
+    assert est.gyro_bias_rad_s == pytest.approx(bias, rel=0.1)
+
+
 def test_a_hand_counts_as_holding_while_its_fingers_stand_around_the_rail():
     """The wrist roll's relief follows the fingers, not the plan's phase: a hand still
     closed on its rail holds it while it starts to open, and one closed on nothing or

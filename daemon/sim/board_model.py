@@ -112,10 +112,15 @@ class BoardModelConfig:
         physics_dt_s: physics step; must divide the 5 ms tick [s].
         trip: board protection thresholds.
         grip: grasp latch thresholds.
+        gyro_bias_rad_s: what the IMUs' gyros read at rest, ``wx, wy, wz`` [rad/s]. The
+            default, 0.006°/s about z and 0.003°/s about x and y (about 20°/h and 10°/h),
+            is the in-run bias instability of a tactical-grade MEMS gyro: what is left
+            after ``iniSensors`` zeroes it at rest (docs/decisions/gyro-heading.md).
     """
 
     battery_v: float = DEFAULT_BATTERY_V
     physics_dt_s: float = 0.00125
+    gyro_bias_rad_s: tuple[float, float, float] = (5e-5, -5e-5, 1e-4)
     trip: BoardTripConfig = field(default_factory=BoardTripConfig)
     grip: GripConfig = field(default_factory=GripConfig)
 
@@ -214,6 +219,7 @@ class BoardModel:
         self._kp0 = m.actuator_gainprm[self.pos_act, 0].copy()
         self._kv0 = -m.actuator_biasprm[self.pos_act, 2].copy()
         self._sensor_index = SensorIndex(m)
+        self._gyro_bias_rad_s = np.asarray(self.config.gyro_bias_rad_s, dtype=float)
         self._separate_fingers_from_rails()
         self.trips = BoardTripMonitor(self.limits.torque_max_nm, self.config.trip)
         rails = {}
@@ -382,9 +388,10 @@ class BoardModel:
         active = ~self.trips.tripped.copy()
         pwm = np.zeros(NUM_JOINTS, dtype=bool)
         pwm[self.cols] = self._pwm_mask
+        sensors = read_sensors(self.data, self._sensor_index, self._gyro_bias_rad_s)
         return BoardState(self.time_s, self._ref.copy(), self.joint_pos(), vel, tau,
                           self.motors.current_a(tau), self._duty.copy(), pwm, active,
-                          read_sensors(self.data, self._sensor_index), v, amps, watts)
+                          sensors, v, amps, watts)
 
     def fill_state(self, sample: np.ndarray) -> None:
         """Write the current state into a ``daemon.structs.STATE_DTYPE`` sample."""

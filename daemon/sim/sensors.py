@@ -70,8 +70,12 @@ class SensorIndex:
         self.imu = [(adr(n + "_a"), adr(n + "_w")) for n in IMU_SENSORS]
 
 
-def read_sensors(data: mujoco.MjData, index: SensorIndex) -> SensorReading:
-    """The sensors' values after ``mj_step`` / ``mj_forward`` (see the module docstring)."""
+def read_sensors(data: mujoco.MjData, index: SensorIndex,
+                 gyro_bias_rad_s: np.ndarray | None = None) -> SensorReading:
+    """The sensors' values after ``mj_step`` / ``mj_forward`` (see the module docstring).
+
+    ``gyro_bias_rad_s``: what every gyro reads at rest, ``wx, wy, wz`` [rad/s]: MuJoCo's
+    gyro is exact, a MEMS gyro's is not (`BoardModelConfig.gyro_bias_rad_s`)."""
     sd = data.sensordata
     ft = np.empty((4, 3))
     for k, (fa, ta) in enumerate(index.ft):
@@ -82,4 +86,6 @@ def read_sensors(data: mujoco.MjData, index: SensorIndex) -> SensorReading:
     for k, (aa, wa) in enumerate(index.imu):
         imu[k, :3] = sd[aa:aa + 3]
         imu[k, 3:] = sd[wa:wa + 3]
+    if gyro_bias_rad_s is not None:
+        imu[:, 3:] += gyro_bias_rad_s
     return SensorReading(ft, imu)

@@ -25,11 +25,22 @@ class EstimatorConfig:
         foot_contact_on_n: foot F/T load above which a foot stands [N].
         foot_contact_off_n: load below which it has lifted [N] (hysteresis).
         tilt_filter_s: time constant of the accelerometer's low-pass filter [s].
+        level_s: time constant with which the gyro-propagated attitude follows the
+            accelerometer's roll and pitch [s].
+        heading_s: time constant with which the gyro's heading follows the standing
+            feet's (leg odometry) while they agree [s]; the gyro's bias is learnt at
+            the same rate (a critically damped PI observer).
+        foot_turn_rad: a standing foot whose heading disagrees with the gyro's by more
+            than this has turned on its rung: it is anchored again at the gyro's
+            heading [rad].
     """
 
     foot_contact_on_n: float = 60.0
     foot_contact_off_n: float = 25.0
     tilt_filter_s: float = 0.05
+    level_s: float = 0.5
+    heading_s: float = 20.0
+    foot_turn_rad: float = math.radians(0.3)
 
 
 #: field → (lowest, highest) allowed value.
@@ -45,6 +56,7 @@ _RANGES = {
     "verify_timeout_s": (0.1, 5.0),
     "arrival_tolerance_m": (0.002, 0.05),
     "arrival_timeout_s": (0.0, 10.0),
+    "aim_tolerance_m": (0.005, 0.05),
     "hold_after_stop_s": (0.0, 30.0),
     "landing_load_n": (5.0, 200.0),
     "landing_wait_s": (0.0, 5.0),
@@ -77,6 +89,8 @@ class MotionConfig:
         arrival_tolerance_m: how close the palm must come to where its reference puts it
             before the hand closes [m].
         arrival_timeout_s: the longest wait for that [s].
+        aim_tolerance_m: an arrived palm farther than this across its rail from where the
+            holding hands measured the rails is moved there before it closes [m].
         hold_after_stop_s: how long the pose is held after the layer stops, before the
             run ends (validation only) [s].
         landing_load_n: foot F/T load that shows a foot standing on its rung at the end
@@ -107,6 +121,7 @@ class MotionConfig:
     verify_timeout_s: float = 1.5
     arrival_tolerance_m: float = 0.01
     arrival_timeout_s: float = 4.0
+    aim_tolerance_m: float = 0.015
     hold_after_stop_s: float = 2.0
     landing_load_n: float = 20.0
     landing_wait_s: float = 0.5

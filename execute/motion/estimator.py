@@ -3,11 +3,20 @@
 - **Tilt** from the body IMU's accelerometer, low-pass filtered: at rest it measures the
   reaction to gravity, which gives the pelvis's roll and pitch (hubo-motion-rt used the
   waist IMU the same way).
-- **Pose** by leg odometry. The world frame is the robot's start frame: the soles stand
-  flat, facing its x axis, where the plan's first stance puts them. A foot whose F/T
-  sensor carries load (``foot_contact_on_n``) is anchored where the estimate puts it as
-  it lands; while anchored, the pelvis pose follows from that foot's pose and the leg's
-  encoders. A foot that unloads (``foot_contact_off_n``) drops its anchor.
+- **Attitude** from the body IMU's gyro, integrated every sample. Its roll and pitch
+  follow the accelerometer (``level_s``); its heading follows the standing feet's (leg
+  odometry) while they agree with it (``heading_s``), and the gyro's bias is learnt from
+  the same disagreement. A standing foot whose heading departs from the gyro's by more
+  than ``foot_turn_rad`` has turned on its rung; it is anchored again at the gyro's
+  heading. Leg odometry alone cannot see a stance that turns as a whole: on `ship` the
+  body turned 3.4° on its standing feet while a hand reached, and the reach closed
+  7 cm beside its rail (docs/decisions/gyro-heading.md).
+- **Position** by leg odometry. The world frame is the robot's start frame: the soles
+  stand flat, facing its x axis, where the plan's first stance puts them. A foot whose
+  F/T sensor carries load (``foot_contact_on_n``) is anchored where the estimate puts its
+  sole as it lands; while anchored, the pelvis follows from that point, the attitude and
+  the leg's encoders (the anchors' mean, weighted by load). A foot that unloads
+  (``foot_contact_off_n``) drops its anchor.
 - **Limb poses**: palms and soles in the world from the pose and the encoders.
 - **Finger curl** per hand, the mean of its five finger encoders: what grasp verification
   reads (`execute.motion.grasp_check`).
@@ -75,17 +84,27 @@ def tilt_from_gravity(up_in_pelvis: np.ndarray) -> np.ndarray:
                      [-s * ky, s * kx, c]])
 
 
-def _rigid_inverse(T: np.ndarray) -> np.ndarray:
-    """The inverse of a rigid transform (4, 4): (Rᵀ, −Rᵀ p)."""
-    out = np.eye(4)
-    Rt = T[:3, :3].T
-    out[:3, :3] = Rt
-    out[:3, 3] = -Rt @ T[:3, 3]
-    return out
+def _rotation(rotvec: np.ndarray) -> np.ndarray:
+    """The rotation matrix of a rotation vector [rad] (Rodrigues; it runs every tick)."""
+    x, y, z = (float(v) for v in rotvec)
+    angle = math.sqrt(x * x + y * y + z * z)
+    if angle < 1e-12:
+        return np.eye(3)
+    K = np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]]) / angle
+    return np.eye(3) + math.sin(angle) * K + (1.0 - math.cos(angle)) * (K @ K)
+
+
+def _heading_rad(R: np.ndarray) -> float:
+    """The heading of a frame's x axis in the world's horizontal plane [rad]."""
+    return math.atan2(float(R[1, 0]), float(R[0, 0]))
+
+
+def _wrap(angle_rad: float) -> float:
+    return (angle_rad + math.pi) % (2.0 * math.pi) - math.pi
 
 
 class StateEstimator:
-    """Leg odometry, IMU tilt and limb poses (see the module docstring).
+    """Gyro attitude, leg odometry and limb poses (see the module docstring).
 
     Args:
         model: the robot model.
@@ -101,8 +120,11 @@ class StateEstimator:
         self._fingers = {side: joint_indices(FINGER_JOINTS[side]) for side in SIDES}
         self._up: np.ndarray | None = None
         self._T_world_pelvis: np.ndarray | None = None
-        self._anchors: dict[str, np.ndarray] = {}
+        #: side → (sole position [m], sole heading [rad]) where the standing foot landed
+        self._anchors: dict[str, tuple[np.ndarray, float]] = {}
         self._last_t: float | None = None
+        self.gyro_bias_rad_s = 0.0  #: the heading rate the gyro reads at rest [rad/s]
+        self.foot_turns = 0  #: standing feet anchored again at the gyro's heading
 
     def _tilt(self, s: SensedState) -> np.ndarray:
         f = s.body_specific_force()
@@ -125,9 +147,43 @@ class StateEstimator:
         T[:3, 3] = want - got
         return T
 
+    def _attitude(self, R: np.ndarray, s: SensedState, dt: float) -> np.ndarray:
+        """The pelvis attitude after ``dt`` [s]: the gyro's turn (less its learnt
+        heading bias), then a step towards the accelerometer's up."""
+        R = _rotation([0.0, 0.0, -self.gyro_bias_rad_s * dt]) @ R \
+            @ _rotation(s.body_angular_rate() * dt)
+        up_seen = self._up / np.linalg.norm(self._up)  # pelvis frame
+        up_now = R[2]  # the world's z seen from the pelvis
+        axis = np.cross(up_seen, up_now)
+        gap = math.atan2(float(np.linalg.norm(axis)), float(up_seen @ up_now))
+        if gap < 1e-12:
+            return R
+        return R @ _rotation(axis / np.linalg.norm(axis) * gap * min(1.0, dt / self.config.level_s))
+
+    def _follow_feet(self, R: np.ndarray, feet: dict[str, np.ndarray],
+                     load: dict[str, float], dt: float) -> np.ndarray:
+        """Turn the heading towards the standing feet's where they agree with the gyro;
+        anchor again a foot that turned on its rung."""
+        cfg = self.config
+        gaps, weights = [], []
+        for side, (sole_m, heading) in list(self._anchors.items()):
+            gap = _wrap(heading - _heading_rad(R @ feet[side][:3, :3]))
+            if abs(gap) > cfg.foot_turn_rad:
+                self._anchors[side] = (sole_m, heading - gap)
+                self.foot_turns += 1
+                continue
+            gaps.append(gap)
+            weights.append(max(load[side], 1e-6))
+        if not gaps or dt <= 0.0:
+            return R
+        gap = float(np.average(gaps, weights=weights))
+        self.gyro_bias_rad_s -= gap * dt / cfg.heading_s ** 2
+        return _rotation([0.0, 0.0, 2.0 * gap * min(1.0, dt / cfg.heading_s)]) @ R
+
     def update(self, s: SensedState) -> BodyEstimate:
         """Fold one sample into the estimate."""
         cfg = self.config
+        dt = 0.0 if self._last_t is None else max(0.0, s.time_s - self._last_t)
         R_tilt = self._tilt(s)
         self._last_t = s.time_s
         q = s.pos_rad
@@ -135,27 +191,35 @@ class StateEstimator:
         frames = {side: (T[f"{side[0].upper()}_sole"], T[f"{side[0].upper()}_palm"])
                   for side in SIDES}
         feet = {side: frames[side][0] for side in SIDES}
+        load = {side: s.foot_load_n(side) for side in SIDES}
         if self._T_world_pelvis is None:
             self._T_world_pelvis = self._start_pose(feet)
-            self._anchors = {side: self._T_world_pelvis @ feet[side] for side in SIDES}
-        load = {side: s.foot_load_n(side) for side in SIDES}
+            self._anchors = {side: self._landing(self._T_world_pelvis, feet[side])
+                             for side in SIDES}
+        T_wp = self._T_world_pelvis.copy()
         for side in SIDES:
             if side in self._anchors and load[side] < cfg.foot_contact_off_n:
                 del self._anchors[side]
-        candidates = [(load[side], self._anchors[side] @ _rigid_inverse(feet[side]))
-                      for side in SIDES if side in self._anchors]
-        if candidates:
-            total = sum(max(w, 1e-6) for w, _ in candidates)
-            T = max(candidates, key=lambda c: c[0])[1].copy()
-            T[:3, 3] = sum(max(w, 1e-6) * Tc[:3, 3] for w, Tc in candidates) / total
-            self._T_world_pelvis = T
-        T_wp = self._T_world_pelvis
+        R = self._follow_feet(self._attitude(T_wp[:3, :3], s, dt), feet, load, dt)
+        T_wp[:3, :3] = R
+        if self._anchors:
+            w = np.array([max(load[side], 1e-6) for side in self._anchors])
+            at = [sole_m - R @ feet[side][:3, 3] for side, (sole_m, _h) in self._anchors.items()]
+            T_wp[:3, 3] = np.average(at, axis=0, weights=w)
+        self._T_world_pelvis = T_wp
         for side in SIDES:
             if side not in self._anchors and load[side] > cfg.foot_contact_on_n:
-                self._anchors[side] = T_wp @ feet[side]
+                self._anchors[side] = self._landing(T_wp, feet[side])
         return BodyEstimate(
             s.time_s, T_wp.copy(), R_tilt, {side: side in self._anchors for side in SIDES},
             {side: (T_wp @ frames[side][1])[:3, 3] for side in SIDES},
             {side: (T_wp @ feet[side])[:3, 3] for side in SIDES},
             {side: float(q[self._fingers[side]].sum()) / len(self._fingers[side])
              for side in SIDES})
+
+    @staticmethod
+    def _landing(T_world_pelvis: np.ndarray,
+                 foot_in_pelvis: np.ndarray) -> tuple[np.ndarray, float]:
+        """A foot's anchor as it lands: its sole's position and heading in the world."""
+        T = T_world_pelvis @ foot_in_pelvis
+        return T[:3, 3].copy(), _heading_rad(T[:3, :3])

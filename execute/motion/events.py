@@ -16,6 +16,7 @@ class MotionEventKind(enum.Enum):
     GRASP_VERIFIED = "grasp verified"  #: the fingers read closed on a rail
     GRASP_MISSED = "grasp missed"  #: the fingers closed on nothing
     RE_REACH = "re-reach"  #: a missed hand opens, moves and closes again
+    AIM = "aim"  #: an arrived hand moved onto its rail as the holding hands measured it
     ARRIVAL_WAIT = "arrival wait"  #: a hand lagged its reference; the grasp waited for it
     STIFF_REACH = "stiff reach"  #: a compliant arm short of its hold finished in position mode
     LEG_RELIEF = "leg relief"  #: the gripping arms began to lift more: a leg joint neared its limit

@@ -11,6 +11,10 @@ hubo-motion-rt and the thesis's operator did (thesis §4.3.4, §6.2):
   moved it in position mode through the air (mixed), then finishes the reach in position
   mode and waits as long again; it complies again once its grasp is verified (the mixed
   strategy: position in the air, PWM on the rail);
+- **aim before closing**: an arrived palm that the estimate puts farther than
+  ``aim_tolerance_m`` across its rail from where the holding hands measured the rails is
+  moved there (bounded) before the hand closes. The body can turn on its standing feet
+  while a hand reaches (3.4° on `ship`); the gyro's heading lets the estimate see it;
 - **grasp verification**: at the end of every grasp the plan makes, the player waits
   until the finger encoders read the hand closed on its rail
   (`execute.motion.grasp_check`). Only then does the plan go on to put load on it;
@@ -377,15 +381,14 @@ class MotionLayer:
         side, rail, planned = pending
         if line_index >= seg.last_line - 1:
             return _Regrasp(side, k, rail, planned, "verify", self._now)
-        if line_index == seg.first_line - 1:
+        if line_index == seg.first_line - 1 and (k, side) not in self._arrived:
             limb = f"{side}_hand"
             wanted = self._ladder_shift(planned)
             if np.linalg.norm(wanted - self._shift_m.get(limb, np.zeros(3))) > SAME_TARGET_M:
                 g = _Regrasp(side, k, rail, planned, "retarget", self._now)
                 self._move_hand(g, wanted, "the ladder estimate moved its target")
                 return g
-            if (k, side) not in self._arrived:
-                return _Regrasp(side, k, rail, planned, "arrive", self._now)
+            return _Regrasp(side, k, rail, planned, "arrive", self._now)
         return None
 
     def _palm_lag_m(self, side: str, s: SensedState) -> float:
@@ -406,9 +409,7 @@ class MotionLayer:
         towards_ladder = -self.geometry.rung_line_normal
         step = self.config.search_step_m
         current = self._shift_m.get(f"{g.side}_hand", np.zeros(3))
-        axis = self._rail_direction(g.rail)
-        miss = self.estimate.palm_m[g.side] - (g.planned_m + current)
-        miss -= (miss @ axis) * axis
+        miss = self._across_rail(g, self.estimate.palm_m[g.side] - (g.planned_m + current))
         pattern = [self._bounded(centre + step * (across * towards_ladder
                                                   + lateral * self.geometry.lateral_direction))
                    for across, lateral in SEARCH_PATTERN]
@@ -418,7 +419,29 @@ class MotionLayer:
                 out.append(shift)
         return out
 
-    def _move_hand(self, g: _Regrasp, shift: np.ndarray, why: str) -> None:
+    def _across_rail(self, g: _Regrasp, offset_m: np.ndarray) -> np.ndarray:
+        """``offset_m`` less its share along the rail of grasp ``g`` [m]."""
+        axis = self._rail_direction(g.rail)
+        return offset_m - (offset_m @ axis) * axis
+
+    def _aim(self, g: _Regrasp) -> bool:
+        """Move an arrived hand onto its rail as the holding hands measured it, if the
+        estimate puts its palm farther than ``aim_tolerance_m`` across the rail from there.
+        Returns whether it moves."""
+        limb = f"{g.side}_hand"
+        current = self._shift_m.get(limb, np.zeros(3))
+        rail_m = g.planned_m + self._ladder_shift(g.planned_m, self.rails)
+        miss = self._across_rail(g, self.estimate.palm_m[g.side] - rail_m)
+        if float(np.linalg.norm(miss)) <= self.config.aim_tolerance_m:
+            return False
+        self._move_hand(g, self._bounded(current - miss),
+                        f"the palm stood {np.linalg.norm(miss) * 100:.1f} cm across its rail "
+                        "from where the holding hands measured it; aimed before closing",
+                        MotionEventKind.AIM)
+        return True
+
+    def _move_hand(self, g: _Regrasp, shift: np.ndarray, why: str,
+                   kind: MotionEventKind | None = None) -> None:
         """Blend the hand's offset to one that moves it by ``shift`` [m], over shift_s."""
         limb = f"{g.side}_hand"
         dq, residual = self._limb_shift_dq(limb, self._line, shift)
@@ -426,7 +449,8 @@ class MotionLayer:
                                      self._now + self.config.shift_s,
                                      time_based=True)
         self._shift_m[limb] = shift
-        kind = MotionEventKind.RE_REACH if g.tries else MotionEventKind.REACH_CORRECTION
+        if kind is None:
+            kind = MotionEventKind.RE_REACH if g.tries else MotionEventKind.REACH_CORRECTION
         self._event(kind, limb, float(np.linalg.norm(shift)),
                     f"{why}: target moved {np.round(shift * 100, 1).tolist()} cm (IK "
                     f"residual {residual * 1000:.1f} mm)")
@@ -470,6 +494,9 @@ class MotionLayer:
                     self._event(MotionEventKind.ARRIVAL_WAIT, limb, lag,
                                 f"waited {elapsed:.2f} s for the palm to reach its reference "
                                 f"before closing ({lag * 100:.1f} cm off at the end)")
+                if self._aim(g):
+                    g.phase, g.since_s = "retarget", now
+                    return
                 self._regrasp = None
                 self.player.resume(now)
         elif g.phase in ("verify", "close"):

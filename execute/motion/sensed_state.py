@@ -73,3 +73,7 @@ class SensedState:
     def body_specific_force(self) -> np.ndarray:
         """The body IMU's accelerometer ``ax, ay, az`` [m/s²] (pelvis frame)."""
         return self.imu[_IMU_SLOT["IMU"], :3]
+
+    def body_angular_rate(self) -> np.ndarray:
+        """The body IMU's gyro ``wx, wy, wz`` [rad/s] (pelvis frame)."""
+        return self.imu[_IMU_SLOT["IMU"], 3:]
