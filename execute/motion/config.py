@@ -66,6 +66,7 @@ _RANGES = {
     "strike_backoff_m": (0.0, 0.06),
     "strike_backoff_s": (0.1, 3.0),
     "strike_tries": (0, 4),
+    "hand_strike_load_n": (5.0, 100.0),
 }
 
 
@@ -106,6 +107,10 @@ class MotionConfig:
         strike_backoff_m: how far such a foot backs away from the ladder, each time [m].
         strike_backoff_s: how long the back-off takes, the player paused [s].
         strike_tries: back-offs per step before the layer stops the climb.
+        hand_strike_load_n: a reaching hand whose wrist F/T reads more than this along
+            the forearm is pushed by the ladder (in the air it reads its own weight,
+            −3 to −12 N) [N]; it backs off as a foot does (``strike_backoff_m``,
+            ``strike_tries``), along the push.
         estimator: the state estimator's thresholds.
     """
 
@@ -131,6 +136,7 @@ class MotionConfig:
     strike_backoff_m: float = 0.03
     strike_backoff_s: float = 0.3
     strike_tries: int = 2
+    hand_strike_load_n: float = 15.0
     estimator: EstimatorConfig = field(default_factory=EstimatorConfig)
 
     def __post_init__(self) -> None:

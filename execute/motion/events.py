@@ -23,6 +23,7 @@ class MotionEventKind(enum.Enum):
     LADDER_ESTIMATE = "ladder estimate"  #: the estimate of the ladder's pose changed
     FOOT_LANDING = "foot landing"  #: a step ended with its foot unloaded; it reached further
     FOOT_STRIKE = "foot strike"  #: a swinging foot met something from above; it backed off
+    HAND_STRIKE = "hand strike"  #: a reaching hand was pushed by the ladder; it backed off
     STOP = "stop"  #: the layer holds the pose and stops the climb
 
 

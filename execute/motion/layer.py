@@ -163,12 +163,13 @@ class _Landing:
 
 @dataclass
 class _Strike:
-    """A swinging foot that met something from above, backing off while the player waits."""
+    """A swinging foot that met something from above, or a reaching hand that the ladder
+    pushed, backing off while the player waits."""
 
-    side: str
+    limb: str
     segment: int
     since_s: float
-    backoff_dq: np.ndarray  # the leg's joint offset once backed off [rad]
+    backoff_dq: np.ndarray  # the limb's joint offset once backed off [rad]
     target_dq: np.ndarray  # the step's own correction at its last line [rad]
 
 
@@ -675,46 +676,61 @@ class MotionLayer:
 
     # ------------------------------------------------------------------ swing strikes
     def _strike_due(self, line_index: int, s: SensedState) -> _Strike | None:
-        """A foot in the middle of its step whose F/T sensor reads a push from above:
-        start its back-off (or stop the climb once its step has used its back-offs)."""
+        """A foot in the middle of its step whose F/T sensor reads a push from above, or a
+        hand on its way to a rail that its wrist F/T shows pushed by the ladder: start its
+        back-off (or, for a foot, stop the climb once its step has used its back-offs)."""
         k = int(self._segment_of_line[line_index])
         seg = self.sidecar.segments[k]
         if seg.phase != "limb" or line_index >= seg.last_line - 1:
-            return None  # the step's end is the guarded landing's
+            return None  # the step's end is the guarded landing's; a grasp's, the aim's
         cfg = self.config
         for limb in seg.moving_limbs:
-            if not limb.endswith("_foot"):
-                continue
             side = _side(limb)
-            load = s.foot_load_n(side)
-            if load > -cfg.strike_load_n:
-                continue
-            tries = self._strikes.get(k, 0)
             target = self._next_hold[k].get(limb, (k, None))[1]
-            rung = target.target if target is not None else "its hold"
+            hold = target.target if target is not None else "its hold"
+            if limb.endswith("_foot"):
+                load = s.foot_load_n(side)
+                if load > -cfg.strike_load_n:
+                    continue
+                away = -self.geometry.R_world_ladder[:, 0]  # horizontal, from the ladder
+                direction = away + [0.0, 0.0, -STRIKE_DOWN_SHARE]
+                why = (f"its F/T read {load:.0f} N (a foot in the air reads about −12 N): "
+                       f"something presses on it from above on its way to {hold}")
+                kind = MotionEventKind.FOOT_STRIKE
+            else:
+                load = float(s.hand_wrench(side)[2])
+                if load < cfg.hand_strike_load_n:
+                    continue
+                # the ladder pushes the hand towards the wrist: it gives way along the push
+                frame = self.model.chains[limb].frame
+                direction = self.estimate.T_world_pelvis[:3, :3] @ \
+                    self.model.frame_in_pelvis(s.pos_rad, frame)[:3, 2]
+                why = (f"its wrist F/T read {load:.0f} N along the forearm (a hand in the "
+                       f"air reads −3 to −12 N): the ladder pushes it on its way to {hold}")
+                kind = MotionEventKind.HAND_STRIKE
+            tries = self._strikes.get(k, 0)
             if tries >= cfg.strike_tries:
+                if limb.endswith("_hand"):
+                    continue  # its grasp is verified at the reach's end
                 reason = (f"{limb} was pressed from above ({load:.0f} N on its F/T) on its "
-                          f"way to {rung} after {tries} back-off{'s' if tries != 1 else ''}: "
+                          f"way to {hold} after {tries} back-off{'s' if tries != 1 else ''}: "
                           "the step was not finished and no weight moved onto it")
-                self._stop_step(limb, rung, reason, tries, 0.0)
+                self._stop_step(limb, hold, reason, tries, 0.0)
                 return None
             self._strikes[k] = tries + 1
-            away = -self.geometry.R_world_ladder[:, 0]  # horizontal, from the ladder
             backoff = cfg.strike_backoff_m * (tries + 1)
-            shift = (self._shift_m.get(limb, np.zeros(3)) + backoff * away
-                     + [0.0, 0.0, -STRIKE_DOWN_SHARE * backoff])
+            shift = self._shift_m.get(limb, np.zeros(3)) + backoff * np.asarray(direction)
             backoff_dq, _residual = self._limb_shift_dq(limb, line_index, shift)
             blend = self._offsets.get(limb)
-            # the step's own correction, reached at its last line (a first strike finds it
+            # the reach's own correction, reached at its last line (a first strike finds it
             # as the reach correction's blend; a later one as the last strike's)
             target_dq = blend.end if blend is not None else np.zeros_like(backoff_dq)
             self._offsets[limb] = _Blend(self._offset(limb), backoff_dq, self._now,
                                          self._now + cfg.strike_backoff_s, time_based=True)
-            self._event(MotionEventKind.FOOT_STRIKE, limb, backoff,
-                        f"its F/T read {load:.0f} N (a foot in the air reads about −12 N): "
-                        f"something presses on it from above on its way to {rung}; it backs "
-                        f"{backoff * 100:.0f} cm away from the ladder and rises from there")
-            return _Strike(side, k, self._now, backoff_dq, target_dq)
+            self._event(kind, limb, backoff,
+                        f"{why}; it backs off {backoff * 100:.0f} cm and goes on from there "
+                        "to the highest point of its reach")
+            return _Strike(limb, k, self._now, backoff_dq, target_dq)
         return None
 
     def _update_strike(self) -> None:
@@ -724,8 +740,11 @@ class MotionLayer:
         if self._now < f.since_s + self.config.strike_backoff_s:
             return
         seg = self.sidecar.segments[f.segment]
-        limb = f"{f.side}_foot"
-        apex = self._apex_line(limb, self._line, seg.last_line - 1)
+        limb = f.limb
+        # a foot keeps its back-off up to its step's highest point; a hand, whose reach
+        # rises along its rail to the end, lets it go over the rest of the reach
+        apex = self._apex_line(limb, self._line, seg.last_line - 1) \
+            if limb.endswith("_foot") else self._line
         self._offsets[limb] = _Blend(f.backoff_dq, f.target_dq, float(apex),
                                      float(seg.last_line - 1))
         self._strike = None
