@@ -90,13 +90,18 @@ def test_a_foot_that_finds_no_rung_stops_the_climb_before_loading_it(mount):
     assert run.log.line_index.max() <= step.last_line - 1
 
 
-def _play_on_kinematic_robot(mount, press_n, press_from, press_ticks):
+#: limb → its F/T sensor's slot in the state sample (``daemon.structs.FT_NAMES``)
+_FT_SLOT = {"right_foot": 0, "left_foot": 1, "right_hand": 2, "left_hand": 3}
+
+
+def _play_on_kinematic_robot(mount, press_n, press_from, press_ticks, limb="left_foot"):
     """The mount's motion layer on a robot that is only encoders and F/T sensors: the
     joints are where the layer sent them, fingers stop on the rail, a held foot carries
-    300 N and a foot in the air reads its own weight, except that the left foot reads
-    ``press_n`` for ``press_ticks`` ticks once its step onto rung 0 is ``press_from`` of
-    the way through. Returns (layer, per-tick (line, left sole's reference relative to
-    the plan's, in the pelvis frame [m])), up to the end of that step."""
+    300 N and a foot in the air reads its own weight, except that ``limb``'s F/T reads
+    ``press_n`` for ``press_ticks`` ticks once its first move (the left foot's step onto
+    rung 0; the hands' reach to the rails) is ``press_from`` of the way through. Returns (layer, per-tick
+    (line, the limb's reference frame relative to the plan's, in the pelvis frame
+    [m])), up to the end of that move."""
     from daemon.structs import STATE_DTYPE, new_sample
     from execute.motion.layer import MotionLayer
     from execute.play.player import PlayerOptions, TrajectoryPlayer
@@ -107,11 +112,11 @@ def _play_on_kinematic_robot(mount, press_n, press_from, press_ticks):
     traj = read_trajectory(mount, sc.rate_hz)
     ladder = load_ladder("drc")
     step = next(seg for seg in sc.segments if seg.phase == "limb"
-                and seg.moving_limbs == ("left_foot",))
+                and limb in seg.moving_limbs)
     press_line = step.first_line - 1 + round(press_from * (step.last_line - step.first_line))
     layer = MotionLayer(TrajectoryPlayer(traj, PlayerOptions(rate_hz=int(sc.rate_hz))),
                         traj, sc, ladder)
-    frame = layer.model.chains["left_foot"].frame
+    frame = layer.model.chains[limb].frame
     fingers = [JOINT_INDEX[f] for side in FINGER_JOINTS for f in FINGER_JOINTS[side]]
     curl = finger_contact_curl_rad(ladder.rail_radius_m)
     ref, pressed, trace, t = traj[0].copy(), 0, [], 0.0
@@ -125,7 +130,7 @@ def _play_on_kinematic_robot(mount, press_n, press_from, press_ticks):
         for k, side in ((0, "right"), (1, "left")):
             sample["ft"][k]["fz"] = 300.0 if f"{side}_foot" in seg.holds else -12.0
         if layer._line >= press_line and pressed < press_ticks:
-            sample["ft"][1]["fz"] = press_n
+            sample["ft"][_FT_SLOT[limb]]["fz"] = press_n
             pressed += 1
         ref = layer.step(t, sample).ref_rad
         line = layer._line
@@ -153,6 +158,27 @@ def test_a_foot_pressed_from_above_on_its_way_backs_off_and_steps_on(mount):
     assert np.linalg.norm(trace[-1][1]) < 0.005  # the step still ends on its hold
 
 
+def test_a_hand_the_ladder_pushes_on_its_way_backs_off_and_reaches_its_hold(mount):
+    """A reaching hand whose wrist F/T reads a push along the forearm (its palm plate on
+    the rail) stops, gives way along the push, and still reaches its hold."""
+    layer, trace = _play_on_kinematic_robot(mount, 40.0, 0.4, 10, limb="right_hand")
+    strikes = [e for e in layer.events if e.kind.value == "hand strike"]
+    assert len(strikes) == 1 and strikes[0].limb == "right_hand", layer.events
+    assert layer.stop is None
+    k = next(i for i, (line, _off) in enumerate(trace) if line + 1 >= strikes[0].line)
+    backoff_ticks = round(layer.config.strike_backoff_s / 0.005)
+    lines = [line for line, _off in trace[k: k + backoff_ticks]]
+    assert max(lines) - min(lines) <= 1  # the reach waited while the hand backed off
+    moved = trace[k + backoff_ticks][1]
+    assert np.linalg.norm(moved) == pytest.approx(layer.config.strike_backoff_m, abs=0.01)
+    # along the push: the forearm's axis, from the palm towards the wrist
+    line = trace[k + backoff_ticks][0]
+    along = layer.model.frame_in_pelvis(layer.trajectory_rad[line],
+                                        layer.model.chains["right_hand"].frame)[:3, 2]
+    assert moved @ along > 0.8 * np.linalg.norm(moved)
+    assert np.linalg.norm(trace[-1][1]) < 0.005  # the reach still ends on its hold
+
+
 def test_a_foot_still_pressed_after_its_back_offs_stops_the_climb(mount):
     layer, trace = _play_on_kinematic_robot(mount, -80.0, 0.4, 100_000)
     strikes = [e for e in layer.events if e.kind.value == "foot strike"]
@@ -160,3 +186,53 @@ def test_a_foot_still_pressed_after_its_back_offs_stops_the_climb(mount):
     assert strikes[1].size_m == pytest.approx(2 * layer.config.strike_backoff_m)
     assert layer.stop is not None and layer.stop.cause.value == "foothold_unverified"
     assert "pressed from above" in layer.stop.reason
+
+
+def test_a_stance_that_turns_while_the_hands_reach_is_seen_and_the_hands_aimed(mount):
+    """The kinematic robot's stance turns 3° about the vertical while its hands reach for
+    the rails (its gyro reads the turn; no encoder moves): the estimate sees it from the
+    gyro, and each hand is aimed at its hold before it closes, by about the turn's
+    displacement of the palm."""
+    from daemon.structs import STATE_DTYPE, new_sample
+    from execute.motion.layer import MotionLayer
+    from execute.play.player import PlayerOptions, TrajectoryPlayer
+    from robot.joints import FINGER_JOINTS, JOINT_INDEX
+    from robot.kinematic_tree import finger_contact_curl_rad
+
+    sc = read_sidecar(sidecar_path(mount))
+    traj = read_trajectory(mount, sc.rate_hz)
+    ladder = load_ladder("drc")
+    reach = sc.segments[0]
+    assert reach.phase == "limb" and set(reach.moving_limbs) == {"left_hand", "right_hand"}
+    layer = MotionLayer(TrajectoryPlayer(traj, PlayerOptions(rate_hz=int(sc.rate_hz))),
+                        traj, sc, ladder)
+    turn_rad, turn_s = np.radians(3.0), 3.0
+    fingers = [JOINT_INDEX[f] for side in FINGER_JOINTS for f in FINGER_JOINTS[side]]
+    curl = finger_contact_curl_rad(ladder.rail_radius_m)
+    ref, t, turned = traj[0].copy(), 0.0, 0.0
+    grasps = [seg.last_line for seg in sc.segments[1:3]]
+    while layer._line < grasps[-1] - 1 and layer.stop is None and t < 200.0:
+        sample = new_sample(STATE_DTYPE)
+        sample["time_s"] = t
+        sample["pos"][:] = ref
+        sample["pos"][fingers] = np.minimum(ref[fingers], curl)
+        sample["imu"][0]["az"] = 9.81
+        if layer._line >= reach.first_line + (reach.last_line - reach.first_line) // 2 \
+                and turned < turn_rad:
+            sample["imu"][0]["wz"] = turn_rad / turn_s
+            turned += turn_rad / turn_s * 0.005
+        for k in (0, 1):
+            sample["ft"][k]["fz"] = 300.0
+        ref = layer.step(t, sample).ref_rad
+        t += 0.005
+    heading = np.arctan2(layer.estimate.T_world_pelvis[1, 0], layer.estimate.T_world_pelvis[0, 0])
+    assert heading == pytest.approx(turn_rad, abs=np.radians(0.3))
+    aims = {e.limb: e for e in layer.events if e.kind.value == "aim"}
+    assert set(aims) == {"left_hand", "right_hand"}, layer.events
+    both = sc.segments[3].holds  # the dwell after the grasps: both hands on their rails
+    for side in ("left", "right"):
+        # the turn carried the planned palm round the soles' midpoint by the turn's angle
+        palm = np.asarray(both[f"{side}_hand"].position_m)
+        lever = np.linalg.norm(palm[:2])
+        assert aims[f"{side}_hand"].size_m == pytest.approx(lever * turn_rad, rel=0.35)
+    assert layer.stop is None

@@ -27,12 +27,11 @@ class EstimatorConfig:
         tilt_filter_s: time constant of the accelerometer's low-pass filter [s].
         level_s: time constant with which the gyro-propagated attitude follows the
             accelerometer's roll and pitch [s].
-        heading_s: time constant with which the gyro's heading follows the standing
-            feet's (leg odometry) while they agree [s]; the gyro's bias is learnt at
+        heading_s: time constant with which the gyro's heading follows the feet's (leg
+            odometry) while both stand on the floor [s]; the gyro's bias is learnt at
             the same rate (a critically damped PI observer).
-        foot_turn_rad: a standing foot whose heading disagrees with the gyro's by more
-            than this has turned on its rung: it is anchored again at the gyro's
-            heading [rad].
+        foot_turn_rad: a foot on the floor whose heading disagrees with the gyro's by
+            more than this has turned: it is anchored again at the gyro's heading [rad].
     """
 
     foot_contact_on_n: float = 60.0

@@ -4,13 +4,15 @@
   reaction to gravity, which gives the pelvis's roll and pitch (hubo-motion-rt used the
   waist IMU the same way).
 - **Attitude** from the body IMU's gyro, integrated every sample. Its roll and pitch
-  follow the accelerometer (``level_s``); its heading follows the standing feet's (leg
-  odometry) while they agree with it (``heading_s``), and the gyro's bias is learnt from
-  the same disagreement. A standing foot whose heading departs from the gyro's by more
-  than ``foot_turn_rad`` has turned on its rung; it is anchored again at the gyro's
-  heading. Leg odometry alone cannot see a stance that turns as a whole: on `ship` the
-  body turned 3.4° on its standing feet while a hand reached, and the reach closed
-  7 cm beside its rail (docs/decisions/gyro-heading.md).
+  follow the accelerometer (``level_s``). While both feet stand on the floor, its heading
+  follows theirs (leg odometry, ``heading_s``) and the gyro's bias is learnt from the
+  disagreement; a foot whose heading departs from the gyro's by more than
+  ``foot_turn_rad`` has turned and is anchored again at the gyro's heading. On the
+  ladder the heading is the gyro's alone, less that bias: feet on rungs turn (on the DRC
+  ladder they departed from the gyro by more than 0.3° 180 times in 400 s) and are no
+  reference. Leg odometry alone cannot see a stance that turns as a whole: on `ship` the
+  body turned 3.4° on its standing feet while a hand reached, and the reach closed 7 cm
+  beside its rail (docs/decisions/gyro-heading.md).
 - **Position** by leg odometry. The world frame is the robot's start frame: the soles
   stand flat, facing its x axis, where the plan's first stance puts them. A foot whose
   F/T sensor carries load (``foot_contact_on_n``) is anchored where the estimate puts its
@@ -39,6 +41,8 @@ from robot.joints import FINGER_JOINTS, joint_indices
 __all__ = ["BodyEstimate", "StateEstimator"]
 
 SIDES = ("left", "right")
+#: A sole within this of the start soles' height stands on the floor [m].
+FLOOR_TOLERANCE_M = 0.02
 _FRAMES = ("L_sole", "R_sole", "L_palm", "R_palm")
 
 
@@ -160,10 +164,18 @@ class StateEstimator:
             return R
         return R @ _rotation(axis / np.linalg.norm(axis) * gap * min(1.0, dt / self.config.level_s))
 
+    def _on_start_floor(self) -> bool:
+        """Whether every anchored foot stands on the floor the robot started on."""
+        floor_m = min(float(p[2]) for p in self.start_soles_m.values())
+        return bool(self._anchors) and all(abs(float(sole_m[2]) - floor_m) < FLOOR_TOLERANCE_M
+                                           for sole_m, _heading in self._anchors.values())
+
     def _follow_feet(self, R: np.ndarray, feet: dict[str, np.ndarray],
                      load: dict[str, float], dt: float) -> np.ndarray:
-        """Turn the heading towards the standing feet's where they agree with the gyro;
-        anchor again a foot that turned on its rung."""
+        """On the floor, turn the heading towards the standing feet's where they agree
+        with the gyro, learn the gyro's bias, and anchor again a foot that turned."""
+        if not self._on_start_floor():
+            return R
         cfg = self.config
         gaps, weights = [], []
         for side, (sole_m, heading) in list(self._anchors.items()):

@@ -12,8 +12,8 @@ hubo-motion-rt and the thesis's operator did (thesis §4.3.4, §6.2):
   mode and waits as long again; it complies again once its grasp is verified (the mixed
   strategy: position in the air, PWM on the rail);
 - **aim before closing**: an arrived palm that the estimate puts farther than
-  ``aim_tolerance_m`` across its rail from where the holding hands measured the rails is
-  moved there (bounded) before the hand closes. The body can turn on its standing feet
+  ``aim_tolerance_m`` across its rail from where a hand last held that rail is moved
+  there (bounded) before the hand closes. The body can turn on its standing feet
   while a hand reaches (3.4° on `ship`); the gyro's heading lets the estimate see it;
 - **grasp verification**: at the end of every grasp the plan makes, the player waits
   until the finger encoders read the hand closed on its rail
@@ -34,7 +34,10 @@ hubo-motion-rt and the thesis's operator did (thesis §4.3.4, §6.2):
   planned) stops, the player paused, and backs away from the ladder by
   ``strike_backoff_m``; it keeps that back-off while it rises, to the highest point of its
   step, and reaches its hold from there. After ``strike_tries`` back-offs in one step the
-  layer **stops** as for a grasp;
+  layer **stops** as for a grasp. A reaching hand that its wrist F/T shows pushed by the
+  ladder along the forearm (its palm plate on the rail it leaves, the body nearer the
+  ladder than planned) backs off along the push the same way, and lets the back-off go
+  over the rest of its reach; its grasp is verified at the end as every grasp is;
 - **a guard on stiff arms**: a stiff arm that pushes near a torque limit complies again;
 - **wrist-roll relief** of a gripping arm (`execute.motion.wrist_relief`), from its motor
   current, while its fingers hold the rail;
@@ -222,6 +225,8 @@ class MotionLayer:
         #: side → (rail, planned hold [m]) of a verified grasp the hand still holds
         self._held_rails: dict[str, tuple[str, np.ndarray]] = {}
         self._arrived: set[tuple[int, str]] = set()
+        #: rail → where a hand last held it: its palm in the estimate's world [m]
+        self._rail_seen: dict[str, np.ndarray] = {}
         self._last_ref = np.asarray(trajectory_rad[0], dtype=float).copy()
         self._regrasp: _Regrasp | None = None
         self._landing: _Landing | None = None
@@ -334,6 +339,7 @@ class MotionLayer:
                 continue
             self.rails.add(RailObservation(rail, planned_m, self.estimate.palm_m[side],
                                            self._rail_direction(rail)), fits_yaw=on_floor)
+            self._rail_seen[rail] = self.estimate.palm_m[side].copy()
 
     def _enter_segment(self, k: int) -> None:
         """Measure the held rails again; re-target the reaches of segment ``k`` from the
@@ -426,18 +432,25 @@ class MotionLayer:
         return offset_m - (offset_m @ axis) * axis
 
     def _aim(self, g: _Regrasp) -> bool:
-        """Move an arrived hand onto its rail as the holding hands measured it, if the
-        estimate puts its palm farther than ``aim_tolerance_m`` across the rail from there.
-        Returns whether it moves."""
+        """Move an arrived hand onto its rail where a hand last held that rail (before
+        any grasp of it, where the ladder estimate puts the hold), if the estimate puts
+        its palm farther than ``aim_tolerance_m`` across the rail from there. Returns
+        whether it moves.
+
+        The rail's last hold, not the rails estimate's fit: that fit is one shift for
+        both rails, and it set the two hands' aims against each other by ±2–6 cm on the
+        DRC ladder (2026-11-28)."""
         limb = f"{g.side}_hand"
         current = self._shift_m.get(limb, np.zeros(3))
-        rail_m = g.planned_m + self._ladder_shift(g.planned_m, self.rails)
+        rail_m = self._rail_seen.get(g.rail)
+        if rail_m is None:
+            rail_m = g.planned_m + self._ladder_shift(g.planned_m)
         miss = self._across_rail(g, self.estimate.palm_m[g.side] - rail_m)
         if float(np.linalg.norm(miss)) <= self.config.aim_tolerance_m:
             return False
         self._move_hand(g, self._bounded(current - miss),
                         f"the palm stood {np.linalg.norm(miss) * 100:.1f} cm across its rail "
-                        "from where the holding hands measured it; aimed before closing",
+                        "from where it was last held; aimed before closing",
                         MotionEventKind.AIM)
         return True
 
@@ -586,6 +599,7 @@ class MotionLayer:
         on_floor = self._feet_on_floor(self.sidecar.segments[g.segment])
         self.rails.add(observed, fits_yaw=on_floor)
         self._held_rails[g.side] = (g.rail, g.planned_m)
+        self._rail_seen[g.rail] = palm.copy()
         if on_floor:
             # standing on the floor, leg odometry is exact; on the ladder it carries the
             # feet's creep, which would read as the ladder moving
