@@ -99,9 +99,9 @@ def _play_on_kinematic_robot(mount, press_n, press_from, press_ticks, limb="left
     joints are where the layer sent them, fingers stop on the rail, a held foot carries
     300 N and a foot in the air reads its own weight, except that ``limb``'s F/T reads
     ``press_n`` for ``press_ticks`` ticks once its first move (the left foot's step onto
-    rung 0; the hands' reach to the rails) is ``press_from`` of the way through. Returns (layer, per-tick
-    (line, the limb's reference frame relative to the plan's, in the pelvis frame
-    [m])), up to the end of that move."""
+    rung 0; the hands' reach to the rails) is ``press_from`` of the way through.
+    Returns (layer, per-tick (line, the limb's reference frame relative to the plan's,
+    in the pelvis frame [m])), up to the end of that move."""
     from daemon.structs import STATE_DTYPE, new_sample
     from execute.motion.layer import MotionLayer
     from execute.play.player import PlayerOptions, TrajectoryPlayer
@@ -141,18 +141,25 @@ def _play_on_kinematic_robot(mount, press_n, press_from, press_ticks, limb="left
     return layer, trace
 
 
-def test_a_foot_pressed_from_above_on_its_way_backs_off_and_steps_on(mount):
-    """A swinging foot whose F/T reads a push from above (its toe rising under a rung)
-    stops, backs away from the ladder, rises from there and still lands on its hold."""
-    layer, trace = _play_on_kinematic_robot(mount, -80.0, 0.4, 10)
-    strikes = [e for e in layer.events if e.kind.value == "foot strike"]
-    assert len(strikes) == 1 and strikes[0].limb == "left_foot", layer.events
+def _backed_off_once(layer, trace, kind: str, limb: str):
+    """Check that ``limb`` backed off once (event ``kind``) while the plan waited, and
+    return (line, the limb's offset from the plan) once it has."""
+    strikes = [e for e in layer.events if e.kind.value == kind]
+    assert len(strikes) == 1 and strikes[0].limb == limb, layer.events
     assert layer.stop is None
     k = next(i for i, (line, _off) in enumerate(trace) if line + 1 >= strikes[0].line)
     backoff_ticks = round(layer.config.strike_backoff_s / 0.005)
     lines = [line for line, _off in trace[k: k + backoff_ticks]]
-    assert max(lines) - min(lines) <= 1  # the step waited while the foot backed off
-    away = trace[k + backoff_ticks][1]  # pelvis frame: x towards the ladder, z up
+    assert max(lines) - min(lines) <= 1  # the move waited while the limb backed off
+    return trace[k + backoff_ticks]
+
+
+def test_a_foot_pressed_from_above_on_its_way_backs_off_and_steps_on(mount):
+    """A swinging foot whose F/T reads a push from above (its toe rising under a rung)
+    stops, backs away from the ladder, rises from there and still lands on its hold."""
+    layer, trace = _play_on_kinematic_robot(mount, -80.0, 0.4, 10)
+    _line, away = _backed_off_once(layer, trace, "foot strike", "left_foot")
+    # pelvis frame: x towards the ladder, z up
     assert away[0] == pytest.approx(-layer.config.strike_backoff_m, abs=0.01)
     assert away[2] < -0.005
     assert np.linalg.norm(trace[-1][1]) < 0.005  # the step still ends on its hold
@@ -162,17 +169,9 @@ def test_a_hand_the_ladder_pushes_on_its_way_backs_off_and_reaches_its_hold(moun
     """A reaching hand whose wrist F/T reads a push along the forearm (its palm plate on
     the rail) stops, gives way along the push, and still reaches its hold."""
     layer, trace = _play_on_kinematic_robot(mount, 40.0, 0.4, 10, limb="right_hand")
-    strikes = [e for e in layer.events if e.kind.value == "hand strike"]
-    assert len(strikes) == 1 and strikes[0].limb == "right_hand", layer.events
-    assert layer.stop is None
-    k = next(i for i, (line, _off) in enumerate(trace) if line + 1 >= strikes[0].line)
-    backoff_ticks = round(layer.config.strike_backoff_s / 0.005)
-    lines = [line for line, _off in trace[k: k + backoff_ticks]]
-    assert max(lines) - min(lines) <= 1  # the reach waited while the hand backed off
-    moved = trace[k + backoff_ticks][1]
+    line, moved = _backed_off_once(layer, trace, "hand strike", "right_hand")
     assert np.linalg.norm(moved) == pytest.approx(layer.config.strike_backoff_m, abs=0.01)
     # along the push: the forearm's axis, from the palm towards the wrist
-    line = trace[k + backoff_ticks][0]
     along = layer.model.frame_in_pelvis(layer.trajectory_rad[line],
                                         layer.model.chains["right_hand"].frame)[:3, 2]
     assert moved @ along > 0.8 * np.linalg.norm(moved)
