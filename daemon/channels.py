@@ -339,6 +339,7 @@ class ShmChannel(Channel):
         self._stuck: dict[int, int] = {}  # slot → counter seen odd for too long
         # slot → (counter, key, buffer) of the last published (even) row seen
         self._published: dict[int, tuple[int, tuple[int, int, int], int]] = {}
+        self._last_read: np.ndarray | None = None  # the newest sample this reader returned
         self._fence = threading.Lock()
         if _SYS_FUTEX is None:
             raise ChannelError(f"shared-memory channels need Linux futexes on x86-64 or "
@@ -494,12 +495,17 @@ class ShmChannel(Channel):
         return np.ndarray((), self.dtype, buffer=buf)
 
     def read_latest(self) -> np.ndarray | None:
+        """The newest sample, or — while every writer this reader could read is caught
+        mid-publish and it missed their last complete row — the last sample it read, as
+        an Ach reader keeps its last frame (a daemon preempted mid-publish on a loaded
+        machine had handed a player None). None only if it never read one."""
         for _ in range(_ODD_SPIN):
             found = self._newest()
             if found is None:
-                return None
+                return None if self._last_read is None else self._last_read.copy()
             sample = self._read_slot(found[0], found[2], found[3])
             if sample is not None:
+                self._last_read = sample  # a fresh buffer; the fallback hands out copies
                 return sample
         raise ChannelError(f"{self.path}: could not read a consistent sample")
 

@@ -247,6 +247,26 @@ def test_a_writer_preempted_mid_publish_hides_nothing(instance, caplog):
     w.close()
 
 
+def test_a_reader_that_missed_the_last_row_keeps_its_last_sample(instance, caplog):
+    """A writer caught mid-publish while the reader missed its previous row (it read
+    nothing since an older one): the reader hands out the last sample it read, not None
+    (a player given None by a preempted daemon stopped, 2026-11-28)."""
+    w = ShmChannel("ref", instance)
+    w.write(_ref(1.0))
+    r = ShmChannel("ref", instance)
+    assert float(r.read_latest()["ref"][0]) == 1.0
+    w.write(_ref(2.0))
+    w.write(_ref(3.0))  # r reads neither
+    w._table[w._row] = w._counter + 1  # the next publish starts and stops there
+    with caplog.at_level(logging.WARNING, logger="daemon.channels"):
+        got = r.read_latest()
+    assert got is not None and float(got["ref"][0]) == 1.0
+    fresh = ShmChannel("ref", instance)  # never read anything: nothing to keep
+    assert fresh.read_latest() is None
+    for c in (fresh, r, w):
+        c.close()
+
+
 # ---------------------------------------------------------------- real processes
 
 

@@ -94,50 +94,69 @@ def test_a_foot_that_finds_no_rung_stops_the_climb_before_loading_it(mount):
 _FT_SLOT = {"right_foot": 0, "left_foot": 1, "right_hand": 2, "left_hand": 3}
 
 
-def _play_on_kinematic_robot(mount, press_n, press_from, press_ticks, limb="left_foot"):
-    """The mount's motion layer on a robot that is only encoders and F/T sensors: the
-    joints are where the layer sent them, fingers stop on the rail, a held foot carries
-    300 N and a foot in the air reads its own weight, except that ``limb``'s F/T reads
-    ``press_n`` for ``press_ticks`` ticks once its first move (the left foot's step onto
-    rung 0; the hands' reach to the rails) is ``press_from`` of the way through.
-    Returns (layer, per-tick (line, the limb's reference frame relative to the plan's,
-    in the pelvis frame [m])), up to the end of that move."""
-    from daemon.structs import STATE_DTYPE, new_sample
-    from execute.motion.layer import MotionLayer
-    from execute.play.player import PlayerOptions, TrajectoryPlayer
-    from robot.joints import FINGER_JOINTS, JOINT_INDEX
-    from robot.kinematic_tree import finger_contact_curl_rad
+class _KinematicRobot:
+    """The mount's motion layer on a robot that is only encoders and sensors: the joints
+    are where the layer sent them, fingers stop on the rail, the body IMU reads gravity, a
+    held foot carries 300 N and a foot in the air reads its own weight. `sample` makes
+    the tick's state, which a test may change before `step` plays it."""
 
-    sc = read_sidecar(sidecar_path(mount))
-    traj = read_trajectory(mount, sc.rate_hz)
-    ladder = load_ladder("drc")
-    step = next(seg for seg in sc.segments if seg.phase == "limb"
-                and limb in seg.moving_limbs)
-    press_line = step.first_line - 1 + round(press_from * (step.last_line - step.first_line))
-    layer = MotionLayer(TrajectoryPlayer(traj, PlayerOptions(rate_hz=int(sc.rate_hz))),
-                        traj, sc, ladder)
-    frame = layer.model.chains[limb].frame
-    fingers = [JOINT_INDEX[f] for side in FINGER_JOINTS for f in FINGER_JOINTS[side]]
-    curl = finger_contact_curl_rad(ladder.rail_radius_m)
-    ref, pressed, trace, t = traj[0].copy(), 0, [], 0.0
-    while layer._line < step.last_line - 1 and layer.stop is None and t < 400.0:
-        seg = sc.segments[int(layer._segment_of_line[layer._line])]
+    def __init__(self, mount):
+        from execute.motion.layer import MotionLayer
+        from execute.play.player import PlayerOptions, TrajectoryPlayer
+        from robot.joints import FINGER_JOINTS, JOINT_INDEX
+        from robot.kinematic_tree import finger_contact_curl_rad
+
+        self.sc = read_sidecar(sidecar_path(mount))
+        self.traj = read_trajectory(mount, self.sc.rate_hz)
+        ladder = load_ladder("drc")
+        self.layer = MotionLayer(TrajectoryPlayer(self.traj,
+                                                  PlayerOptions(rate_hz=int(self.sc.rate_hz))),
+                                 self.traj, self.sc, ladder)
+        self._fingers = [JOINT_INDEX[f] for side in FINGER_JOINTS for f in FINGER_JOINTS[side]]
+        self._curl = finger_contact_curl_rad(ladder.rail_radius_m)
+        self.ref, self.t = self.traj[0].copy(), 0.0
+
+    def sample(self):
+        from daemon.structs import STATE_DTYPE, new_sample
+
+        seg = self.sc.segments[int(self.layer._segment_of_line[self.layer._line])]
         sample = new_sample(STATE_DTYPE)
-        sample["time_s"] = t
-        sample["pos"][:] = ref
-        sample["pos"][fingers] = np.minimum(ref[fingers], curl)
+        sample["time_s"] = self.t
+        sample["pos"][:] = self.ref
+        sample["pos"][self._fingers] = np.minimum(self.ref[self._fingers], self._curl)
         sample["imu"][0]["az"] = 9.81
         for k, side in ((0, "right"), (1, "left")):
             sample["ft"][k]["fz"] = 300.0 if f"{side}_foot" in seg.holds else -12.0
+        return sample
+
+    def step(self, sample) -> None:
+        self.ref = self.layer.step(self.t, sample).ref_rad
+        self.t += 0.005
+
+
+def _play_on_kinematic_robot(mount, press_n, press_from, press_ticks, limb="left_foot"):
+    """The mount on `_KinematicRobot`, whose ``limb`` F/T reads ``press_n`` for
+    ``press_ticks`` ticks once its first move (the left foot's step onto rung 0; the hands'
+    reach to the rails) is ``press_from`` of the way through. Returns (layer, per-tick
+    (line, the limb's reference frame relative to the plan's, in the pelvis frame [m])),
+    up to the end of that move."""
+    robot = _KinematicRobot(mount)
+    layer, traj = robot.layer, robot.traj
+    step = next(seg for seg in robot.sc.segments if seg.phase == "limb"
+                and limb in seg.moving_limbs)
+    press_line = step.first_line - 1 + round(press_from * (step.last_line - step.first_line))
+    frame = layer.model.chains[limb].frame
+    pressed, trace = 0, []
+    while layer._line < step.last_line - 1 and layer.stop is None and robot.t < 400.0:
+        sample = robot.sample()
         if layer._line >= press_line and pressed < press_ticks:
             sample["ft"][_FT_SLOT[limb]]["fz"] = press_n
             pressed += 1
-        ref = layer.step(t, sample).ref_rad
+        robot.step(sample)
         line = layer._line
-        off = (layer.model.frame_in_pelvis(ref, frame)[:3, 3]
+        off = (layer.model.frame_in_pelvis(robot.ref, frame)[:3, 3]
                - layer.model.frame_in_pelvis(traj[line], frame)[:3, 3])
         trace.append((line, off))
-        t += 0.005
     return layer, trace
 
 
@@ -192,38 +211,21 @@ def test_a_stance_that_turns_while_the_hands_reach_is_seen_and_the_hands_aimed(m
     the rails (its gyro reads the turn; no encoder moves): the estimate sees it from the
     gyro, and each hand is aimed at its hold before it closes, by about the turn's
     displacement of the palm."""
-    from daemon.structs import STATE_DTYPE, new_sample
-    from execute.motion.layer import MotionLayer
-    from execute.play.player import PlayerOptions, TrajectoryPlayer
-    from robot.joints import FINGER_JOINTS, JOINT_INDEX
-    from robot.kinematic_tree import finger_contact_curl_rad
-
-    sc = read_sidecar(sidecar_path(mount))
-    traj = read_trajectory(mount, sc.rate_hz)
-    ladder = load_ladder("drc")
+    robot = _KinematicRobot(mount)
+    sc, layer = robot.sc, robot.layer
     reach = sc.segments[0]
     assert reach.phase == "limb" and set(reach.moving_limbs) == {"left_hand", "right_hand"}
-    layer = MotionLayer(TrajectoryPlayer(traj, PlayerOptions(rate_hz=int(sc.rate_hz))),
-                        traj, sc, ladder)
+    assert all({"left_foot", "right_foot"} <= set(seg.holds) for seg in sc.segments[:3])
     turn_rad, turn_s = np.radians(3.0), 3.0
-    fingers = [JOINT_INDEX[f] for side in FINGER_JOINTS for f in FINGER_JOINTS[side]]
-    curl = finger_contact_curl_rad(ladder.rail_radius_m)
-    ref, t, turned = traj[0].copy(), 0.0, 0.0
+    turned = 0.0
     grasps = [seg.last_line for seg in sc.segments[1:3]]
-    while layer._line < grasps[-1] - 1 and layer.stop is None and t < 200.0:
-        sample = new_sample(STATE_DTYPE)
-        sample["time_s"] = t
-        sample["pos"][:] = ref
-        sample["pos"][fingers] = np.minimum(ref[fingers], curl)
-        sample["imu"][0]["az"] = 9.81
+    while layer._line < grasps[-1] - 1 and layer.stop is None and robot.t < 200.0:
+        sample = robot.sample()
         if layer._line >= reach.first_line + (reach.last_line - reach.first_line) // 2 \
                 and turned < turn_rad:
             sample["imu"][0]["wz"] = turn_rad / turn_s
             turned += turn_rad / turn_s * 0.005
-        for k in (0, 1):
-            sample["ft"][k]["fz"] = 300.0
-        ref = layer.step(t, sample).ref_rad
-        t += 0.005
+        robot.step(sample)
     heading = np.arctan2(layer.estimate.T_world_pelvis[1, 0], layer.estimate.T_world_pelvis[0, 0])
     assert heading == pytest.approx(turn_rad, abs=np.radians(0.3))
     aims = {e.limb: e for e in layer.events if e.kind.value == "aim"}

@@ -121,6 +121,7 @@ class StateEstimator:
         self.model = model
         self.config = config or EstimatorConfig()
         self.start_soles_m = {k: np.asarray(v, dtype=float) for k, v in start_soles_m.items()}
+        self._floor_m = min(float(p[2]) for p in self.start_soles_m.values())
         self._fingers = {side: joint_indices(FINGER_JOINTS[side]) for side in SIDES}
         self._up: np.ndarray | None = None
         self._T_world_pelvis: np.ndarray | None = None
@@ -159,16 +160,17 @@ class StateEstimator:
         up_seen = self._up / np.linalg.norm(self._up)  # pelvis frame
         up_now = R[2]  # the world's z seen from the pelvis
         axis = np.cross(up_seen, up_now)
-        gap = math.atan2(float(np.linalg.norm(axis)), float(up_seen @ up_now))
-        if gap < 1e-12:
+        sin_gap = float(np.linalg.norm(axis))
+        if sin_gap < 1e-12:
             return R
-        return R @ _rotation(axis / np.linalg.norm(axis) * gap * min(1.0, dt / self.config.level_s))
+        gap = math.atan2(sin_gap, float(up_seen @ up_now))
+        return R @ _rotation(axis * (gap / sin_gap * min(1.0, dt / self.config.level_s)))
 
     def _on_start_floor(self) -> bool:
         """Whether every anchored foot stands on the floor the robot started on."""
-        floor_m = min(float(p[2]) for p in self.start_soles_m.values())
-        return bool(self._anchors) and all(abs(float(sole_m[2]) - floor_m) < FLOOR_TOLERANCE_M
-                                           for sole_m, _heading in self._anchors.values())
+        return bool(self._anchors) and all(
+            abs(float(sole_m[2]) - self._floor_m) < FLOOR_TOLERANCE_M
+            for sole_m, _heading in self._anchors.values())
 
     def _follow_feet(self, R: np.ndarray, feet: dict[str, np.ndarray],
                      load: dict[str, float], dt: float) -> np.ndarray:

@@ -67,6 +67,12 @@ class LadderEstimate:
     def observed(self) -> bool:
         return bool(self._latest)
 
+    def last_held_m(self, rail: str) -> np.ndarray | None:
+        """Where a hand last held ``rail``: its measured palm in the world [m]; None if
+        no hand has."""
+        obs = self._latest.get(rail)
+        return None if obs is None else obs.measured_m
+
     def add(self, obs: RailObservation, *, fits_yaw: bool = True) -> None:
         """Fold in a hand on its rail. The newest observation per rail counts: the frame
         drifts as the feet creep.

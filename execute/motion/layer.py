@@ -225,8 +225,6 @@ class MotionLayer:
         #: side → (rail, planned hold [m]) of a verified grasp the hand still holds
         self._held_rails: dict[str, tuple[str, np.ndarray]] = {}
         self._arrived: set[tuple[int, str]] = set()
-        #: rail → where a hand last held it: its palm in the estimate's world [m]
-        self._rail_seen: dict[str, np.ndarray] = {}
         self._last_ref = np.asarray(trajectory_rad[0], dtype=float).copy()
         self._regrasp: _Regrasp | None = None
         self._landing: _Landing | None = None
@@ -339,7 +337,6 @@ class MotionLayer:
                 continue
             self.rails.add(RailObservation(rail, planned_m, self.estimate.palm_m[side],
                                            self._rail_direction(rail)), fits_yaw=on_floor)
-            self._rail_seen[rail] = self.estimate.palm_m[side].copy()
 
     def _enter_segment(self, k: int) -> None:
         """Measure the held rails again; re-target the reaches of segment ``k`` from the
@@ -442,7 +439,7 @@ class MotionLayer:
         DRC ladder (2026-11-28)."""
         limb = f"{g.side}_hand"
         current = self._shift_m.get(limb, np.zeros(3))
-        rail_m = self._rail_seen.get(g.rail)
+        rail_m = self.rails.last_held_m(g.rail)
         if rail_m is None:
             rail_m = g.planned_m + self._ladder_shift(g.planned_m)
         miss = self._across_rail(g, self.estimate.palm_m[g.side] - rail_m)
@@ -599,7 +596,6 @@ class MotionLayer:
         on_floor = self._feet_on_floor(self.sidecar.segments[g.segment])
         self.rails.add(observed, fits_yaw=on_floor)
         self._held_rails[g.side] = (g.rail, g.planned_m)
-        self._rail_seen[g.rail] = palm.copy()
         if on_floor:
             # standing on the floor, leg odometry is exact; on the ladder it carries the
             # feet's creep, which would read as the ladder moving

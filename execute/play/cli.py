@@ -263,7 +263,7 @@ def _play(args, traj, player, auto, motion=None) -> int:
             print(f"play-trajectory: {args.file}: {player.num_lines} lines at "
                   f"{player.options.rate_hz} Hz, {player.duration_s:.1f} s, {modes}"
                   + ("; p pauses" if args.pause else ""), file=sys.stderr, flush=True)
-        return _stream(args, player, motion, ref, state, limits, signals, keys, s)
+        return _stream(args, player, motion, ref, state, limits, signals, keys)
     finally:
         if keys is not None:
             keys.close()
@@ -290,11 +290,9 @@ class _Signals:
         self.toggles += 1
 
 
-def _stream(args, player, motion, ref, state, limits, signals: _Signals, keys,
-            first_state) -> int:
+def _stream(args, player, motion, ref, state, limits, signals: _Signals, keys) -> int:
     """One ``ref`` sample per `TICK_NS` on absolute deadlines, until the file ends (0),
-    the motion layer stops and holds (1) or a signal stops it (130, holding).
-    ``first_state``: the daemon's state sample that the start was checked on."""
+    the motion layer stops and holds (1) or a signal stops it (130, holding)."""
     from daemon.loop import sleep_until_ns
     from daemon.structs import REF_DTYPE, new_sample
     from robot.motors import DEFAULT_BATTERY_V, motor_table
@@ -306,20 +304,16 @@ def _stream(args, player, motion, ref, state, limits, signals: _Signals, keys,
     next_show = 0.0
     t0_s = time.monotonic()
     tick = None
-    latest = first_state
     while True:
         now_s = time.monotonic()
         if keys is not None:
             signals.toggles += keys.presses()
         if signals.stop:
             break
-        # The state only matters to the motion layer, go-to-init's start pose and the
-        # feed-forward's battery voltage. A read that finds no complete sample (the
-        # daemon preempted mid-publish on a loaded machine) keeps the last one, as an
-        # Ach reader keeps its last frame.
-        if motion is not None or not player.started or player.has_feedforward:
-            fresh = state.read_latest()
-            latest = latest if fresh is None else fresh
+        # The state only matters for go-to-init's start pose and the feed-forward's
+        # battery voltage.
+        latest = state.read_latest() if (motion is not None or not player.started
+                                         or player.has_feedforward) else None
         # go-to-init starts from the measured pose, within the limits (the daemon
         # rejects a reference beyond them; an encoder may read a hair past one)
         pos = np.clip(latest["pos"], limits.lower_rad, limits.upper_rad) \
