@@ -72,6 +72,26 @@ def test_the_lift_grows_above_onset_holds_between_and_shrinks_below_release(mode
     assert relief.lift_n == pytest.approx(10.0)
 
 
+def test_a_grip_near_what_it_holds_stops_the_lift_and_takes_it_back(model):
+    """Above ``grip_fraction`` of what a grip holds the lift shrinks, and it grows again
+    only once the grip is below ``grip_release_fraction`` (hysteresis)."""
+    relief = LegRelief(model, rate_n_per_s=40.0, max_lift_n=80.0, grip_fraction=0.5,
+                       grip_release_fraction=0.4)
+    hot = _torque_for("LKN", 0.92)
+    for _ in range(200):  # 1 s: 40 N
+        relief.update(["left"], True, hot, TICK_S, grip_share=0.3)
+    assert relief.lift_n == pytest.approx(40.0)
+    for _ in range(100):  # the grip passes its bound: 0.5 s shrinks 20 N
+        relief.update(["left"], True, hot, TICK_S, grip_share=0.55)
+    assert relief.grip_bound and relief.lift_n == pytest.approx(20.0)
+    for _ in range(100):  # back between the two fractions: still bound, still shrinking
+        relief.update(["left"], True, hot, TICK_S, grip_share=0.45)
+    assert relief.grip_bound and relief.lift_n == pytest.approx(0.0)
+    for _ in range(100):  # below the release fraction it grows again
+        relief.update(["left"], True, hot, TICK_S, grip_share=0.35)
+    assert not relief.grip_bound and relief.lift_n == pytest.approx(20.0)
+
+
 def test_no_lift_without_a_gripping_arm_or_from_a_swing_leg(model):
     relief = LegRelief(model)
     hot = _torque_for("LKN", 0.95)

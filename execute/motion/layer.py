@@ -42,7 +42,9 @@ hubo-motion-rt and the thesis's operator did (thesis §4.3.4, §6.2):
 - **wrist-roll relief** of a gripping arm (`execute.motion.wrist_relief`), from its motor
   current, while its fingers hold the rail;
 - **leg relief** (`execute.motion.leg_relief`): while a stance leg's joint pushes near its
-  torque limit (motor current), the gripping compliant arms lift more of the body;
+  torque limit (motor current), the gripping compliant arms lift more of the body, unless
+  a closed grip's load, estimated from the arms' currents (`execute.motion.grip_load`),
+  nears what it holds;
 - **reach correction**: every verified grasp measures where its rail is
   (`execute.motion.ladder_estimate`); every later reach of a hand or a foot to a hold on
   the ladder is re-targeted by that estimate, by inverse kinematics on the limb's chain
@@ -72,6 +74,7 @@ from execute.motion.events import MotionEvent, MotionEventKind, MotionStop
 from execute.motion.gains import motion_pwm_gains
 from execute.motion.grasp_check import GraspReading, closed_around_rail, read_grasp
 from execute.motion.gravity_compensation import ArmGravityCompensation
+from execute.motion.grip_load import GripLoad
 from execute.motion.ladder_estimate import LadderEstimate, RailObservation
 from execute.motion.leg_relief import LegRelief
 from execute.motion.robot_model import MotionRobotModel
@@ -204,6 +207,7 @@ class MotionLayer:
         self.gravity = ArmGravityCompensation(self.model)
         self.wrist_relief = WristRelief(robot)
         self.leg_relief = LegRelief(self.model, robot)
+        self.grip_load = GripLoad(self.model, ladder.friction, ladder.rail_radius_m)
         #: The gains the daemon should run the compliant arms with (`execute.motion.gains`).
         self.pwm_gains = motion_pwm_gains()
         self._last_now: float | None = None
@@ -821,6 +825,7 @@ class MotionLayer:
         mode = tick.mode
         seg = self.sidecar.segments[int(self._segment_of_line[tick.line_index])]
         lifting: list[str] = []  # compliant arms gripping a rail
+        closed: dict[str, str] = {}  # side → the rail its fingers are closed round
         for side in SIDES:
             hold = seg.holds.get(f"{side}_hand")
             cols = self._arm_cols[side]
@@ -833,6 +838,9 @@ class MotionLayer:
             # grip twisted against the rail loads it whatever the plan's phase
             wrist_roll = WRIST_ROLL[side]
             holding = closed_around_rail(side, s.pos_rad, self.geometry.spec.rail_radius_m)
+            if holding:
+                closed[side] = (hold.target if hold is not None and hold.target.startswith("rail")
+                                else f"rail_{side}")
             ref[wrist_roll] += self.wrist_relief.update(wrist_roll, holding,
                                                         self._sensed_torque_nm, dt)
             share = self.config.holding_arm_stiffness
@@ -850,20 +858,32 @@ class MotionLayer:
         ff = tick.feedforward_nm
         if self.config.gravity_compensation and comply.any():  # else ff goes unused
             ff = self.gravity.feedforward_nm(ff, plan_rad, s.pos_rad, self.estimate.R_tilt)
-        ff = self._relieve_legs(seg, lifting, s, ff, dt)
+        ff = self._relieve_legs(seg, lifting, closed, s, ff, dt)
         if ff is not tick.feedforward_nm or comply is not tick.comply:
             ff = np.where(comply, ff, 0.0)  # feed-forward acts only on compliant joints
         return dataclasses.replace(tick, ref_rad=ref, mode=mode, comply=comply,
                                    feedforward_nm=ff)
 
-    def _relieve_legs(self, seg: Segment, lifting: list[str], s: SensedState,
-                      ff: np.ndarray, dt: float) -> np.ndarray:
-        """``ff`` plus the leg relief's lift on the ``lifting`` arms (`LegRelief`)."""
+    def _relieve_legs(self, seg: Segment, lifting: list[str], closed: dict[str, str],
+                      s: SensedState, ff: np.ndarray, dt: float) -> np.ndarray:
+        """``ff`` plus the leg relief's lift on the ``lifting`` arms (`LegRelief`), bounded
+        by the loads of the grips ``closed`` (side → rail)."""
         stance = [side for side in SIDES if f"{side}_foot" in seg.holds
                   and self.estimate.standing.get(side, False)]
         relief = self.leg_relief
-        before = relief.lift_n
-        lift = relief.update(stance, bool(lifting), self._sensed_torque_nm, dt)
+        before, was_bound = relief.lift_n, relief.grip_bound
+        grip_share = 0.0
+        if lifting:  # the grips bound a lift only; none without a compliant arm to lift
+            grip_share = max((self.grip_load.release_share(
+                side, s.pos_rad, self.estimate.R_tilt, self._sensed_torque_nm,
+                self._rail_direction(rail)) for side, rail in closed.items()), default=0.0)
+        lift = relief.update(stance, bool(lifting), self._sensed_torque_nm, dt, grip_share)
+        if relief.grip_bound and not was_bound and before > 0.0:
+            side = max(closed, key=lambda k: self.grip_load.share.get(k, (0.0, ""))[0])
+            share, what = self.grip_load.share[side]
+            self._event(MotionEventKind.LEG_RELIEF, f"{side}_hand", 0.0,
+                        f"{what} at {share:.0%} of what the {side} grip holds: the lift "
+                        f"of {before:.0f} N gives way")
         if before == 0.0 and lift > 0.0:
             self._event(MotionEventKind.LEG_RELIEF, "", 0.0,
                         f"{JOINT_NAMES[relief.joint_col]} at {relief.load_share:.0%} of its "

@@ -36,6 +36,16 @@ the left knee at 0.76–0.89 of its limit on one foot drove the left hip yaw fro
 the fastest one onto the cone of pushes that load none of them (and do not push down):
 the least change from it that the guard allows, found as a non-negative least-squares
 problem on the cone's polar (Moreau). A hand with no such push adds nothing.
+
+Nor may the lift pry a grip open. The push's reaction goes through the body to every
+hand on a rail, rigid ones too: on a DRC mount (S25, seed 14) 80 N on the compliant left
+arm, with the left knee at 0.84–0.89 of its limit, bent the rigid right hand's grip from
+0.13 to 1.0 of what it holds in 5 s, and it let go; with at most 40 N, or none, the knee
+stayed below its limit and the grip held. The grips' loads are estimated from sensors
+(`execute.motion.grip_load`); while the largest is above ``grip_fraction`` of what the
+grip holds, the lift does not grow and shrinks at ``rate_n_per_s``, until the largest is
+back below ``grip_release_fraction`` (hysteresis: a grip near the bound would otherwise
+switch it every few ticks).
 """
 
 from __future__ import annotations
@@ -67,12 +77,15 @@ class LegRelief:
         max_lift_n: the largest extra lift of all hands together [N].
         guard_fraction: share of its limit above which another joint of the relieved
             leg may not be loaded further by the push.
+        grip_fraction: share of what a grip holds above which the lift gives way.
+        grip_release_fraction: share below which it may grow again.
     """
 
     def __init__(self, model: MotionRobotModel, robot: str = "drc-hubo",
                  onset_fraction: float = 0.85, release_fraction: float = 0.75,
                  rate_n_per_s: float = 40.0, max_lift_n: float = 80.0,
-                 guard_fraction: float = 0.6):
+                 guard_fraction: float = 0.6, grip_fraction: float = 0.5,
+                 grip_release_fraction: float = 0.4):
         self.model = model
         self.limit_nm = joint_limits(robot).torque_max_nm
         self._leg_cols = {side: np.array(joint_indices(WEIGHT_JOINTS[side]))
@@ -80,6 +93,7 @@ class LegRelief:
         self._guard_cols = {f"{side}_foot": np.array(joint_indices(LEG_JOINTS[side]))
                             for side in LEG_JOINTS}
         self.guard_fraction = guard_fraction
+        self.grip_fraction, self.grip_release = grip_fraction, grip_release_fraction
         self.onset, self.release = onset_fraction, release_fraction
         self.rate_n_per_s, self.max_lift_n = rate_n_per_s, max_lift_n
         self.lift_n = 0.0
@@ -91,11 +105,14 @@ class LegRelief:
         self.joint_col, self.joint_sign, self.joint_foot = -1, 0.0, ""
         #: The last tick's largest |τ|/limit over the stance legs' watched joints.
         self.load_share = 0.0
+        #: Whether the last tick's grips were too loaded for the lift to grow.
+        self.grip_bound = False
 
     def update(self, stance_sides: list[str], can_lift: bool, torque_nm: np.ndarray,
-               dt_s: float) -> float:
+               dt_s: float, grip_share: float = 0.0) -> float:
         """The lift after one tick [N]. ``can_lift``: a compliant hand grips a rail;
-        ``torque_nm``: the sensed joint torques by column [N·m]."""
+        ``torque_nm``: the sensed joint torques by column [N·m]; ``grip_share``: the
+        largest estimated load of a closed grip, as a share of what it holds."""
         share, col, side = 0.0, -1, ""
         for leg in stance_sides:
             cols = self._leg_cols[leg]
@@ -104,13 +121,15 @@ class LegRelief:
             if shares[k] > share:
                 share, col, side = float(shares[k]), int(cols[k]), leg
         self.load_share = share
-        if can_lift and share > self.onset:
+        self.grip_bound = grip_share > (self.grip_release if self.grip_bound
+                                        else self.grip_fraction)
+        if can_lift and share > self.onset and not self.grip_bound:
             self.joint_col, self.joint_foot = col, f"{side}_foot"
             self.joint_sign = float(np.sign(torque_nm[col]))
             self.lift_n = min(self.max_lift_n, self.lift_n + self.rate_n_per_s * dt_s)
             if self.lift_n > self.peak_lift_n:
                 self.peak_lift_n, self.peak_joint = self.lift_n, JOINT_NAMES[col]
-        elif share < self.release or not can_lift:
+        elif share < self.release or not can_lift or self.grip_bound:
             self.lift_n = max(0.0, self.lift_n - self.rate_n_per_s * dt_s)
         return self.lift_n
 

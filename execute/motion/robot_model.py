@@ -129,6 +129,25 @@ class MotionRobotModel:
         out[self._have] = jt[self._v_cols]
         return out
 
+    def hand_wrench(self, q_cols_rad: np.ndarray, R_world_pelvis: np.ndarray, hand: str,
+                    torque_nm: np.ndarray) -> np.ndarray:
+        """The environment's wrench on ``hand``'s palm, ``(f [N], m [N·m])`` about the
+        palm frame's origin (the grip centre), world frame, from the arm's joint torques
+        ``torque_nm`` (by column, as the motor currents give them).
+
+        Held still, an arm's joints carry gravity and the hand's load: ``τ = g − Jᵀw``
+        (pinocchio's sign: ``Jᵀw`` is what the wrench adds). The arm's joints (seven on
+        the DRC-Hubo) over-determine the six components; the least-squares ``w`` of
+        ``Jᵀw = g − τ`` is the estimate. It ignores the arm's inertia, small in a
+        climb's slow moves.
+        """
+        cols = np.asarray(self.chains[hand].columns)
+        d = self._kinematics_at(q_cols_rad, R_world_pelvis)
+        J = pin.getFrameJacobian(self.model, d, self._frame_id[self.chains[hand].frame],
+                                 pin.LOCAL_WORLD_ALIGNED)[:, self._v_of_col[cols]]
+        held = self.gravity_torques(q_cols_rad, R_world_pelvis)[cols] - torque_nm[cols]
+        return np.linalg.lstsq(J.T, held, rcond=None)[0]
+
     def stance_torque_gradient(self, q_cols_rad: np.ndarray, R_world_pelvis: np.ndarray,
                                joint_cols: int | np.ndarray, foot: str, hand: str
                                ) -> np.ndarray:
