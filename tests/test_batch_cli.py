@@ -46,6 +46,7 @@ SMALL = JobFunctions(plan=small.small_plan, validate=small.small_validate)
     (["--engine", "dask", "--address", "h:8786"], ["--address", "tcp://host:8786"]),
     (["--ladders", "stair", "--top-rung", "4"], ["--top-rung is 4", "0..3"]),
     (["--ladders", "drc", "--sweep", "s.yaml"], ["not allowed with argument"]),
+    (["--plans-from", "no-such-dir"], ["--plans-from", "no-such-dir", "results.jsonl"]),
 ])
 def test_bad_flags_exit_2_naming_the_option(argv, words, tmp_path, capsys):
     assert main([*argv, "--out", str(tmp_path)]) == 2
@@ -120,6 +121,36 @@ def test_small_sweep_run_writes_a_heat_map(tmp_path):
     assert len(rows) == 6 * 2 and {"slope_deg", "rung_spacing_m"} <= set(rows[0])
     assert rows[0]["ladder"] == "drc.c000" and "drc.c005" in text
     assert (out / "plots" / "heatmap_rung_spacing_m_slope_deg.png").exists()
+
+
+def test_plans_from_an_earlier_batch_are_taken_when_their_inputs_match(tmp_path):
+    """A second batch validates the first one's plans under another perturbation without
+    planning again; a plan with other inputs (here a time limit) is planned anew."""
+    first = tmp_path / "first"
+    code, _ = _run_small(["--ladders", "drc", "--seeds", "3", "--strategies", "mixed",
+                          "--workers", "1", "--out", str(first)])
+    assert code == 0
+    second = tmp_path / "second"
+    argv = ["--ladders", "drc", "--seeds", "4", "--strategies", "mixed", "--perturb",
+            "placement=0.03", "--workers", "1", "--out", str(second),
+            "--plans-from", str(first)]
+    err = Console(file=io.StringIO(), width=240)
+    assert run(parse_args(argv), Console(file=io.StringIO()), err, functions=SMALL) == 0
+    assert "took 3 of 4 plan(s)" in err.file.getvalue()
+    records = [json.loads(x) for x in (second / RESULTS_FILE).read_text().splitlines()]
+    plans = [r for r in records if r["kind"] == "plan"]
+    assert sorted(r["seed"] for r in plans if r.get("reused_from")) == [1, 2, 3]
+    assert [r["seed"] for r in plans if not r.get("reused_from")] == [4]  # planned here
+    for r in plans:
+        assert (second / r["traj"]).read_text() == (first / r["traj"]).read_text() \
+            if r.get("reused_from") else (second / r["traj"]).is_file()
+    assert sum(r["kind"] == "validate" for r in records) == 4
+    third = tmp_path / "third"
+    other = parse_args(argv[:-4] + ["--time-limit", "30", "--out", str(third),
+                                    "--plans-from", str(first)])
+    assert run(other, Console(file=io.StringIO()), err, functions=SMALL) == 0
+    records = [json.loads(x) for x in (third / RESULTS_FILE).read_text().splitlines()]
+    assert not any(r.get("reused_from") for r in records)  # other inputs: planned anew
 
 
 def test_errored_jobs_give_exit_1(tmp_path):

@@ -4,8 +4,8 @@
                [--strategies mixed,position,pwm] [--loop closed,open]
                [--perturb KEY=V,...] [--draws D]
                [--engine local|dask] [--address tcp://host:8786] [--workers K]
-               [--out DIR] [--time-limit S] [--top-rung K] [--robot R] [--rate HZ]
-               [--max-jobs N] [--no-plots] [-v]
+               [--out DIR] [--plans-from DIR] [--time-limit S] [--top-rung K] [--robot R]
+               [--rate HZ] [--max-jobs N] [--no-plots] [-v]
 
 Per (ladder, seed) one plan (seeds S..S+N−1), then per strategy × loop × perturbation
 draw one simulated climb of that plan (closed loop through the motion layer, open loop
@@ -13,8 +13,10 @@ as the file is; both loops of a strategy see the same draws) (`execute.batch.job
 `execute.batch.perturb`; sweeps: `execute.batch.sweep`). Jobs run on a local process
 pool or a Dask cluster (`execute.batch.engine`). Every finished job is appended to
 ``DIR/results.jsonl``; running the same command again skips finished jobs and retries
-errored ones. At the end: the success table (printed, ``DIR/summary.csv``,
-``DIR/summary.md``) and plots in ``DIR/plots``.
+errored ones. ``--plans-from`` takes the plans of an earlier batch's directory whose
+inputs match instead of planning them again (`execute.batch.plan_reuse`). At the end:
+the success table (printed, ``DIR/summary.csv``, ``DIR/summary.md``) and plots in
+``DIR/plots``.
 
 Exit codes: 0 every job has an outcome (climbs may have failed: that is the data); 1 some
 jobs errored or the cluster failed; 2 bad input (the message names the flag or the file
@@ -69,6 +71,10 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--workers", type=int, default=None, metavar="K",
                    help="worker processes (default: the CPU count)")
     p.add_argument("--out", default="batch-out", metavar="DIR", help="output directory")
+    p.add_argument("--plans-from", metavar="DIR", default=None,
+                   help="take the plans of an earlier batch's output directory whose inputs "
+                        "match (ladder, seed, robot, time limit, top rung, rate) instead of "
+                        "planning them again")
     p.add_argument("--time-limit", type=float, default=600.0, metavar="S",
                    help="planning time limit per plan [s] (default 600)")
     p.add_argument("--top-rung", type=int, default=None, metavar="K",
@@ -99,7 +105,8 @@ def parse_args(argv: list[str] | None = None) -> dict:
     Returns:
         A dict with ``ladders`` ([(key, spec, sweep values)]), ``seeds``, ``strategies``,
         ``perturb`` (`PerturbSpec`), ``draws``, ``engine``, ``address``, ``workers``,
-        ``out``, ``time_limit_s``, ``top_rung``, ``robot``, ``rate_hz``, ``max_jobs``,
+        ``out``, ``plans_from``, ``time_limit_s``, ``top_rung``, ``robot``, ``rate_hz``,
+        ``max_jobs``,
         ``plots``, ``verbose``.
 
     Raises:
@@ -107,6 +114,7 @@ def parse_args(argv: list[str] | None = None) -> dict:
         SystemExit: argparse's own errors (exit 2) and ``--help`` (exit 0).
     """
     from execute.batch.perturb import parse_perturb
+    from execute.batch.runner import RESULTS_FILE
 
     a = _parser().parse_args(argv)
     _check_scalar_options(a)
@@ -129,10 +137,14 @@ def parse_args(argv: list[str] | None = None) -> dict:
         if a.top_rung is not None and a.top_rung >= spec.num_rungs:
             raise InputError(f"option --top-rung is {a.top_rung}; ladder '{key}' has rungs "
                              f"0..{spec.num_rungs - 1}")
+    if a.plans_from is not None and not (Path(a.plans_from) / RESULTS_FILE).is_file():
+        raise InputError(f"option --plans-from: {a.plans_from} holds no {RESULTS_FILE} "
+                         "(give the --out directory of an earlier batch-eval run)")
     workers = a.workers or os.cpu_count() or 1
     return {"ladders": ladders, "seeds": list(range(a.first_seed, a.first_seed + a.seeds)),
             "strategies": strategies, "loops": loops, "perturb": perturb, "draws": a.draws,
             "engine": a.engine, "address": a.address, "workers": workers, "out": Path(a.out),
+            "plans_from": None if a.plans_from is None else Path(a.plans_from),
             "time_limit_s": a.time_limit, "top_rung": a.top_rung, "robot": a.robot,
             "rate_hz": a.rate, "max_jobs": a.max_jobs, "plots": not a.no_plots,
             "verbose": a.verbose}
@@ -208,6 +220,12 @@ def run(opts: dict, console, err, functions=None, engine=None) -> int:
                                      loops=opts["loops"])
     out: Path = opts["out"]
     out.mkdir(parents=True, exist_ok=True)
+    if opts.get("plans_from") is not None:
+        from execute.batch.plan_reuse import reuse_plans
+
+        taken = reuse_plans(plans, opts["plans_from"], out, RESULTS_FILE)
+        err.print(f"batch-eval: took {taken} of {len(plans)} plan(s) from "
+                  f"{opts['plans_from']}", highlight=False)
     t0 = time.perf_counter()
     batch = _run_with_progress(plans, validations, opts, err, functions, engine)
     files = _write_reports(batch, plans, validations, opts, console)
