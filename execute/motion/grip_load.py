@@ -32,14 +32,11 @@ class GripLoad:
     def __init__(self, model: MotionRobotModel, friction: float, rail_radius_m: float):
         self.model = model
         self.capacity = GripCapacity.of(default_grip(), friction, rail_radius_m)
-        #: Per side, the last estimate: the largest of `RELEASE_LOADS` as a share of what
-        #: the grip holds, and that load's name.
-        self.share: dict[str, tuple[float, str]] = {}
 
     def release_share(self, side: str, q_rad: np.ndarray, R_tilt: np.ndarray,
-                      torque_nm: np.ndarray, rail_axis: np.ndarray) -> float:
+                      torque_nm: np.ndarray, rail_axis: np.ndarray) -> tuple[float, str]:
         """The largest of the loads that pry a grip open (radial force, bending torque)
-        on ``side``'s hand, as a share of what it holds [-].
+        on ``side``'s hand, as a share of what it holds [-], and that load's name.
 
         Args:
             side: ``left`` or ``right``.
@@ -51,5 +48,4 @@ class GripLoad:
         wrench = self.model.hand_wrench(q_rad, R_tilt, f"{side}_hand", torque_nm)
         parts = self.capacity.utilisation(wrench[:3], wrench[3:], rail_axis)
         what = max(RELEASE_LOADS, key=parts.get)
-        self.share[side] = (parts[what], what)
-        return parts[what]
+        return parts[what], what

@@ -872,15 +872,15 @@ class MotionLayer:
                   and self.estimate.standing.get(side, False)]
         relief = self.leg_relief
         before, was_bound = relief.lift_n, relief.grip_bound
-        grip_share = 0.0
-        if lifting:  # the grips bound a lift only; none without a compliant arm to lift
-            grip_share = max((self.grip_load.release_share(
-                side, s.pos_rad, self.estimate.R_tilt, self._sensed_torque_nm,
-                self._rail_direction(rail)) for side, rail in closed.items()), default=0.0)
-        lift = relief.update(stance, bool(lifting), self._sensed_torque_nm, dt, grip_share)
+        # side → (share, load) of each closed grip; only a lift needs them
+        grips = {side: self.grip_load.release_share(
+                     side, s.pos_rad, self.estimate.R_tilt, self._sensed_torque_nm,
+                     self._rail_direction(rail))
+                 for side, rail in closed.items()} if lifting else {}
+        side = max(grips, key=lambda k: grips[k][0], default="")
+        share, what = grips.get(side, (0.0, ""))
+        lift = relief.update(stance, bool(lifting), self._sensed_torque_nm, dt, share)
         if relief.grip_bound and not was_bound and before > 0.0:
-            side = max(closed, key=lambda k: self.grip_load.share.get(k, (0.0, ""))[0])
-            share, what = self.grip_load.share[side]
             self._event(MotionEventKind.LEG_RELIEF, f"{side}_hand", 0.0,
                         f"{what} at {share:.0%} of what the {side} grip holds: the lift "
                         f"of {before:.0f} N gives way")

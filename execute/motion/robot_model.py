@@ -72,6 +72,8 @@ class MotionRobotModel:
         # a tick asks several questions of the sensed configuration (`_kinematics_at`).
         self._jac_data = m.createData()
         self._jac_at: tuple[np.ndarray, np.ndarray] | None = None
+        #: (joints, tilt, torques) of the last two `gravity_torques` configurations
+        self._gravity_memo: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
 
     # ------------------------------------------------------------------ conversions
     def configuration(self, q_cols_rad: np.ndarray, T_world_pelvis: np.ndarray | None = None
@@ -108,13 +110,20 @@ class MotionRobotModel:
         """Joint torques that hold the robot still against gravity [N·m], by column.
 
         Each joint's torque is that of the bodies beyond it, so only the pelvis's tilt
-        matters, not where it stands.
+        matters, not where it stands. A tick asks for the sensed configuration more than
+        once (gravity compensation, each gripping hand's wrench) beside the plan's: the
+        last two configurations' torques are kept, and a copy is returned.
         """
+        for q, R, g in self._gravity_memo:
+            if np.array_equal(q, q_cols_rad) and np.array_equal(R, R_world_pelvis):
+                return g.copy()
         g = pin.computeGeneralizedGravity(self.model, self.data,
                                           self._tilted(q_cols_rad, R_world_pelvis))
         out = np.zeros(len(JOINT_NAMES))
         out[self._have] = g[self._v_cols]
-        return out
+        self._gravity_memo = [(np.array(q_cols_rad, dtype=float), np.array(R_world_pelvis),
+                               out), *self._gravity_memo[:1]]
+        return out.copy()
 
     def force_torques(self, q_cols_rad: np.ndarray, R_world_pelvis: np.ndarray, limb: str,
                       force_world_n: np.ndarray) -> np.ndarray:
