@@ -92,6 +92,18 @@ def test_a_grip_near_what_it_holds_stops_the_lift_and_takes_it_back(model):
     assert not relief.grip_bound and relief.lift_n == pytest.approx(20.0)
 
 
+def test_the_grips_load_is_needed_only_while_a_lift_is_on_or_due(model):
+    """The layer estimates the grips' load (an arm Jacobian and a least-squares solve
+    per grip) only when the relief could use it."""
+    relief = LegRelief(model, onset_fraction=0.85, release_fraction=0.75)
+    hot, warm = _torque_for("LKN", 0.9), _torque_for("LKN", 0.8)
+    assert not relief.needs_grip_share(["left"], warm)
+    assert not relief.needs_grip_share(["right"], hot)  # the hot knee is not in stance
+    assert relief.needs_grip_share(["left"], hot)
+    relief.update(["left"], True, hot, TICK_S)
+    assert relief.lift_n > 0.0 and relief.needs_grip_share(["left"], warm)  # lift on
+
+
 def test_no_lift_without_a_gripping_arm_or_from_a_swing_leg(model):
     relief = LegRelief(model)
     hot = _torque_for("LKN", 0.95)

@@ -872,11 +872,12 @@ class MotionLayer:
                   and self.estimate.standing.get(side, False)]
         relief = self.leg_relief
         before, was_bound = relief.lift_n, relief.grip_bound
-        # side → (share, load) of each closed grip; only a lift needs them
+        # side → (share, load) of each closed grip; only a lift on or due needs them
+        needed = bool(lifting) and relief.needs_grip_share(stance, self._sensed_torque_nm)
         grips = {side: self.grip_load.release_share(
                      side, s.pos_rad, self.estimate.R_tilt, self._sensed_torque_nm,
                      self._rail_direction(rail))
-                 for side, rail in closed.items()} if lifting else {}
+                 for side, rail in closed.items()} if needed else {}
         side = max(grips, key=lambda k: grips[k][0], default="")
         share, what = grips.get(side, (0.0, ""))
         lift = relief.update(stance, bool(lifting), self._sensed_torque_nm, dt, share)

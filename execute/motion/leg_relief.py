@@ -108,11 +108,10 @@ class LegRelief:
         #: Whether the last tick's grips were too loaded for the lift to grow.
         self.grip_bound = False
 
-    def update(self, stance_sides: list[str], can_lift: bool, torque_nm: np.ndarray,
-               dt_s: float, grip_share: float = 0.0) -> float:
-        """The lift after one tick [N]. ``can_lift``: a compliant hand grips a rail;
-        ``torque_nm``: the sensed joint torques by column [N·m]; ``grip_share``: the
-        largest estimated load of a closed grip, as a share of what it holds."""
+    def _leg_load(self, stance_sides: list[str], torque_nm: np.ndarray
+                  ) -> tuple[float, int, str]:
+        """The largest |τ|/limit over the stance legs' watched joints, its column and its
+        leg."""
         share, col, side = 0.0, -1, ""
         for leg in stance_sides:
             cols = self._leg_cols[leg]
@@ -120,6 +119,22 @@ class LegRelief:
             k = int(np.argmax(shares))
             if shares[k] > share:
                 share, col, side = float(shares[k]), int(cols[k]), leg
+        return share, col, side
+
+    def needs_grip_share(self, stance_sides: list[str], torque_nm: np.ndarray) -> bool:
+        """Whether the next `update` may lift: a lift is on, or a stance leg's watched
+        joint is past the onset. Only then does the grips' load matter (estimating it
+        costs an arm Jacobian and a least-squares solve per grip, each tick)."""
+        return self.lift_n > 0.0 or self._leg_load(stance_sides, torque_nm)[0] > self.onset
+
+    def update(self, stance_sides: list[str], can_lift: bool, torque_nm: np.ndarray,
+               dt_s: float, grip_share: float = 0.0) -> float:
+        """The lift after one tick [N]. ``can_lift``: a compliant hand grips a rail;
+        ``torque_nm``: the sensed joint torques by column [N·m]; ``grip_share``: the
+        largest estimated load of a closed grip, as a share of what it holds (0 when
+        `needs_grip_share` is false: the bound is judged only while a lift is on or
+        would start)."""
+        share, col, side = self._leg_load(stance_sides, torque_nm)
         self.load_share = share
         self.grip_bound = grip_share > (self.grip_release if self.grip_bound
                                         else self.grip_fraction)
