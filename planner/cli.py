@@ -71,6 +71,13 @@ def _parser() -> argparse.ArgumentParser:
                    help="share of its torque limit a joint in position mode may be planned "
                         "to (default %(default)g): the legs take what the compliant arms "
                         "do not give")
+    p.add_argument("--reserve-torque-share", type=float, default=None, metavar="S",
+                   help="plan each step's first samples (--reserve-samples) with "
+                        "position-mode joints at this share of their limits, the rest at "
+                        "--position-torque-share (default: the same share)")
+    p.add_argument("--reserve-samples", type=int, default=10, metavar="N",
+                   help="samples per step tried at --reserve-torque-share (default "
+                        "%(default)s)")
     p.add_argument("--foot-cop-margin", type=float, default=FOOT_COP_MARGIN_M, metavar="M",
                    help="how far the feet's centre of pressure stays inside each sole's "
                         "support [m] (default %(default)g)")
@@ -98,6 +105,11 @@ def _check_args(args: argparse.Namespace) -> None:
              "in (0, 1]"),
             ("--position-torque-share", args.position_torque_share,
              0 < args.position_torque_share <= 1, "in (0, 1]"),
+            ("--reserve-torque-share", args.reserve_torque_share,
+             args.reserve_torque_share is None
+             or 0 < args.reserve_torque_share <= args.position_torque_share,
+             "in (0, --position-torque-share]"),
+            ("--reserve-samples", args.reserve_samples, args.reserve_samples >= 0, "≥ 0"),
             ("--foot-cop-margin", args.foot_cop_margin, 0 <= args.foot_cop_margin <= 0.04,
              "in [0, 0.04] m"),
             ("--foot-friction-share", args.foot_friction_share,
@@ -181,6 +193,10 @@ def _plan(args: argparse.Namespace, err) -> int:
                            time_limit_s=args.time_limit, arm_strategy=args.arm_strategy,
                            max_torque_ratio=args.max_torque_ratio,
                            position_torque_share=args.position_torque_share,
+                           reserve_torque_share=(args.position_torque_share
+                                                 if args.reserve_torque_share is None
+                                                 else args.reserve_torque_share),
+                           reserve_samples=args.reserve_samples,
                            foot_cop_margin_m=args.foot_cop_margin,
                            foot_friction_share=args.foot_friction_share)
     try:

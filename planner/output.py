@@ -289,7 +289,8 @@ def _metrics(result: SearchResult, planner: ClimbPlanner, timed: TimedPlan,
                    "backtracks": st.backtracks, "limb_detours": st.limb_detours,
                    "min_margin_m": _finite(st.min_margin_m),
                    "max_torque_ratio": st.max_torque_ratio, "failures": dict(st.failures),
-                   "leg_clearance_m": _finite(st.leg_clearance_m)}
+                   "leg_clearance_m": _finite(st.leg_clearance_m),
+                   "position_torque_share": _finite(st.position_torque_share)}
                   for st in stats],
         "primitives": per_primitive,
     }
@@ -304,6 +305,7 @@ def _arm_metrics(planner: ClimbPlanner, turn: dict[str, np.ndarray]) -> dict:
         "max_held_palm_turn_line": {side: int(np.argmax(turn[side])) + 1 for side in ARMS},
         "arm_strategy": planner.config.arm_strategy,
         "position_torque_share": planner.config.position_torque_share,
+        "reserve_torque_share": planner.config.reserve_torque_share,
         "foot_cop_margin_m": planner.config.foot_cop_margin_m,
         "foot_friction_share": planner.config.foot_friction_share,
     }

@@ -110,6 +110,12 @@ class PlannerConfig:
     # Share of its torque limit a joint in position mode is planned to (arm_capacity's
     # DEFAULT_POSITION_TORQUE_SHARE says why 0.9).
     position_torque_share: float = DEFAULT_POSITION_TORQUE_SHARE
+    # A step's first `reserve_samples` samples are planned with position-mode joints at
+    # `reserve_torque_share` of their limits, the rest at `position_torque_share`: the
+    # standing leg on the higher rung in a foot's swing is where playback overloads it
+    # (docs/decisions/position-torque-share.md), and the mount plans only at the latter.
+    reserve_torque_share: float = DEFAULT_POSITION_TORQUE_SHARE
+    reserve_samples: int = 10
     # The feet's centre of pressure stays this far inside each sole's support [m]
     # (planner.holds.FOOT_COP_MARGIN_M says why 2 cm).
     foot_cop_margin_m: float = FOOT_COP_MARGIN_M
@@ -168,6 +174,7 @@ class StepStats:
     limb_detours: int = 0  # limb paths found by RRTConnect where the arc collided
     limb_detour_tries: int = 0
     leg_clearance_m: float = np.nan  # the legs' clearance the step was found with [m]
+    position_torque_share: float = np.nan  # the share the step was found with
     # Every failed sample, over all visits of the step: what a no-plan message explains.
     rejected: list[SampleFailure] = field(default_factory=list, repr=False)
 
@@ -714,6 +721,10 @@ class ClimbPlanner:
             relaxed = failures[i] >= self.config.leg_clearance_samples
             self.collision.set_leg_clearance(self.config.min_leg_clearance_m if relaxed
                                              else self.config.leg_clearance_m)
+            self.checker.set_position_torque_share(
+                self.config.reserve_torque_share
+                if failures[i] < self.config.reserve_samples
+                else self.config.position_torque_share)
             try:
                 segs, q_new, stance_new = self.try_step(step, q, stance, radius, stats[i],
                                                         failures[i])
@@ -743,6 +754,7 @@ class ClimbPlanner:
                 continue
             stats[i].seconds += time.perf_counter() - t0
             stats[i].leg_clearance_m = self.collision.leg_clearance_m
+            stats[i].position_torque_share = self.checker.position_torque_share
             states.append((segs, q_new, stance_new))
             if progress is not None:
                 progress(i, len(steps), step, stats[i])

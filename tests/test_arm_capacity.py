@@ -180,3 +180,43 @@ def test_a_lone_compliant_hand_does_not_hold_the_balance(hands_on_rails):
     rigid = ClimbPlanner(load_ladder("drc"), seed=1,
                          config=PlannerConfig(arm_strategy="position"))
     assert rigid.checker.region(one_hand).margin(behind) > 0
+
+
+def test_the_checker_plans_position_joints_to_the_share_it_is_set_to(hands_on_rails):
+    p, _, stance = hands_on_rails
+    rigid, cap = torque_limits_by_joint(), compliant_torque_nm()
+    try:
+        p.checker.set_position_torque_share(0.8)
+        limits = p.checker.torque_limits(stance)
+        assert limits["LKN"] == pytest.approx(0.8 * rigid["LKN"])
+        assert limits["LSP"] == pytest.approx(cap["LSP"])  # a PWM joint keeps its clamp
+    finally:
+        p.checker.set_position_torque_share(p.config.position_torque_share)
+    assert p.checker.torque_limits(stance)["LKN"] == pytest.approx(
+        p.config.position_torque_share * rigid["LKN"])
+
+
+def test_a_step_is_tried_at_the_reserve_share_first_then_at_the_position_share(monkeypatch):
+    """The search plans each step's first ``reserve_samples`` samples with position-mode
+    joints at ``reserve_torque_share``, the rest at ``position_torque_share``, and records
+    which share each step was found with."""
+    from planner.search import _StepRejected
+    from robot.vocabulary import StepFailure
+
+    p = ClimbPlanner(load_ladder("drc"), seed=1, config=PlannerConfig(
+        position_torque_share=0.9, reserve_torque_share=0.8, reserve_samples=3))
+    tried: list[tuple[str, float]] = []
+
+    def try_step(step, q, stance, radius_m, stats, attempt=0):
+        tried.append((step.label, p.checker.position_torque_share))
+        if step.label == "placeRFoot@rung0" and attempt < 5:  # five samples fail
+            raise _StepRejected(StepFailure.NO_LIFT_OFF, "no lift-off pose", "lift-off")
+        return [], q, stance
+
+    monkeypatch.setattr(p, "try_step", try_step)
+    result = p.plan(top_rung=0)
+    shares = [share for label, share in tried if label == "placeRFoot@rung0"]
+    assert shares == [0.8, 0.8, 0.8, 0.9, 0.9, 0.9]
+    by_step = {st.label: st.position_torque_share for st in result.step_stats}
+    assert by_step["placeRFoot@rung0"] == 0.9
+    assert by_step["placeLFoot@rung0"] == 0.8

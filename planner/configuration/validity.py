@@ -70,7 +70,7 @@ class FeasibilityChecker:
         self.position_torque_share = position_torque_share
         self.arm_strategy = arm_strategy
         self.torque_max = torque_limits_by_joint(kin.params.name)
-        self._torque_limits: dict[frozenset, dict[str, float]] = {}
+        self._torque_limits: dict[tuple[frozenset, float], dict[str, float]] = {}
         self._regions: dict[tuple, SupportRegion] = {}
         lower, upper = kin.model.lowerPositionLimit[7:], kin.model.upperPositionLimit[7:]
         self._lower, self._upper = lower.copy(), upper.copy()
@@ -91,14 +91,18 @@ class FeasibilityChecker:
                                                 self.kin.params.total_mass_kg)
         return self._regions[key]
 
+    def set_position_torque_share(self, share: float) -> None:
+        """Plan position-mode joints to ``share`` of their torque limits from now on."""
+        self.position_torque_share = share
+
     def torque_limits(self, stance: Stance) -> dict[str, float]:
         """Torque limit per joint [N·m] while ``stance`` carries the robot."""
-        sides = gripping_sides(h.limb for h in stance.holds)
-        if sides not in self._torque_limits:
-            self._torque_limits[sides] = gripping_torque_limits(
-                self.torque_max, sides, self.arm_strategy,
+        key = (gripping_sides(h.limb for h in stance.holds), self.position_torque_share)
+        if key not in self._torque_limits:
+            self._torque_limits[key] = gripping_torque_limits(
+                self.torque_max, key[0], self.arm_strategy,
                 position_share=self.position_torque_share)
-        return self._torque_limits[sides]
+        return self._torque_limits[key]
 
     def check(self, q: np.ndarray, stance: Stance, contacts: dict[str, str]) -> Verdict:
         """Feasibility of ``q`` when ``stance`` carries the robot.
