@@ -74,7 +74,7 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--reserve-torque-share", type=float, default=None, metavar="S",
                    help="plan each step's first samples (--reserve-samples) with "
                         "position-mode joints at this share of their limits, the rest at "
-                        "--position-torque-share (default: the same share)")
+                        "--position-torque-share (default: no reserve)")
     p.add_argument("--reserve-samples", type=int, default=10, metavar="N",
                    help="samples per step tried at --reserve-torque-share (default "
                         "%(default)s)")
@@ -193,9 +193,7 @@ def _plan(args: argparse.Namespace, err) -> int:
                            time_limit_s=args.time_limit, arm_strategy=args.arm_strategy,
                            max_torque_ratio=args.max_torque_ratio,
                            position_torque_share=args.position_torque_share,
-                           reserve_torque_share=(args.position_torque_share
-                                                 if args.reserve_torque_share is None
-                                                 else args.reserve_torque_share),
+                           reserve_torque_share=args.reserve_torque_share,
                            reserve_samples=args.reserve_samples,
                            foot_cop_margin_m=args.foot_cop_margin,
                            foot_friction_share=args.foot_friction_share)

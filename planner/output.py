@@ -305,7 +305,7 @@ def _arm_metrics(planner: ClimbPlanner, turn: dict[str, np.ndarray]) -> dict:
         "max_held_palm_turn_line": {side: int(np.argmax(turn[side])) + 1 for side in ARMS},
         "arm_strategy": planner.config.arm_strategy,
         "position_torque_share": planner.config.position_torque_share,
-        "reserve_torque_share": planner.config.reserve_torque_share,
+        "reserve_torque_share": planner.config.torque_share(0),
         "foot_cop_margin_m": planner.config.foot_cop_margin_m,
         "foot_friction_share": planner.config.foot_friction_share,
     }

@@ -114,7 +114,8 @@ class PlannerConfig:
     # `reserve_torque_share` of their limits, the rest at `position_torque_share`: the
     # standing leg on the higher rung in a foot's swing is where playback overloads it
     # (docs/decisions/position-torque-share.md), and the mount plans only at the latter.
-    reserve_torque_share: float = DEFAULT_POSITION_TORQUE_SHARE
+    # None: no reserve (the position share throughout).
+    reserve_torque_share: float | None = None
     reserve_samples: int = 10
     # The feet's centre of pressure stays this far inside each sole's support [m]
     # (planner.holds.FOOT_COP_MARGIN_M says why 2 cm).
@@ -130,6 +131,13 @@ class PlannerConfig:
     limb_rrt_max_checks: int = 30000
     limb_rrt_tries_per_step: int = 4
     limb_rrt_after_failures: int = 40
+
+    def torque_share(self, failed_samples: int) -> float:
+        """The share of their torque limits position-mode joints are planned to in a
+        step's sample after ``failed_samples`` failed ones."""
+        if self.reserve_torque_share is None or failed_samples >= self.reserve_samples:
+            return self.position_torque_share
+        return self.reserve_torque_share
 
 
 class PlanningFailed(HuboLadderError):
@@ -721,10 +729,7 @@ class ClimbPlanner:
             relaxed = failures[i] >= self.config.leg_clearance_samples
             self.collision.set_leg_clearance(self.config.min_leg_clearance_m if relaxed
                                              else self.config.leg_clearance_m)
-            self.checker.set_position_torque_share(
-                self.config.reserve_torque_share
-                if failures[i] < self.config.reserve_samples
-                else self.config.position_torque_share)
+            self.checker.set_position_torque_share(self.config.torque_share(failures[i]))
             try:
                 segs, q_new, stance_new = self.try_step(step, q, stance, radius, stats[i],
                                                         failures[i])
