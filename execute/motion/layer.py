@@ -66,6 +66,7 @@ import logging
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from daemon.control_modes import RefMode
 from execute.motion.config import MotionConfig
@@ -228,6 +229,10 @@ class MotionLayer:
         self._verified_segments: set[tuple[int, str]] = set()
         #: side → (rail, planned hold [m]) of a verified grasp the hand still holds
         self._held_rails: dict[str, tuple[str, np.ndarray]] = {}
+        #: side → (world shift [m], world turn) of where a verified grasp holds against
+        #: the plan's palm (`_hold_where_held`)
+        self._held_at: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+        self._sensed_q = np.asarray(trajectory_rad[0], dtype=float).copy()
         self._arrived: set[tuple[int, str]] = set()
         self._last_ref = np.asarray(trajectory_rad[0], dtype=float).copy()
         self._regrasp: _Regrasp | None = None
@@ -290,14 +295,16 @@ class MotionLayer:
         return np.zeros(len(JOINT_NAMES)) if blend is None else blend.on_tick(self._now,
                                                                               self._line)
 
-    def _limb_shift_dq(self, limb: str, line_index: int, shift_world_m: np.ndarray
-                       ) -> tuple[np.ndarray, float]:
-        """Joint offsets that move ``limb`` by ``shift_world_m`` at the plan's pose of
-        ``line_index``."""
+    def _limb_shift_dq(self, limb: str, line_index: int, shift_world_m: np.ndarray,
+                       turn_world: np.ndarray | None = None) -> tuple[np.ndarray, float]:
+        """Joint offsets that move ``limb`` by ``shift_world_m`` and turn it by
+        ``turn_world`` (world frame; the ladder estimate's yaw when None) at the plan's
+        pose of ``line_index``."""
         R_world_pelvis = self.estimate.T_world_pelvis[:3, :3]
-        yaw = self.ladder.yaw_rad
-        c, s = np.cos(yaw), np.sin(yaw)
-        turn_world = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+        if turn_world is None:
+            yaw = self.ladder.yaw_rad
+            c, s = np.cos(yaw), np.sin(yaw)
+            turn_world = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
         return self.model.limb_correction(self.trajectory_rad[line_index],
                                           self.model.chains[limb],
                                           R_world_pelvis.T @ shift_world_m,
@@ -338,6 +345,7 @@ class MotionLayer:
             if hold is None or hold.target != rail \
                     or np.linalg.norm(np.asarray(hold.position_m) - planned_m) > SAME_TARGET_M:
                 del self._held_rails[side]
+                self._held_at.pop(side, None)
                 continue
             self.rails.add(RailObservation(rail, planned_m, self.estimate.palm_m[side],
                                            self._rail_direction(rail)), fits_yaw=on_floor)
@@ -347,6 +355,12 @@ class MotionLayer:
         ladder estimate."""
         seg = self.sidecar.segments[k]
         self._observe_held_rails(seg)
+        for side, (shift_world_m, turn_world) in self._held_at.items():
+            limb = f"{side}_hand"
+            dq, _residual = self._limb_shift_dq(limb, seg.last_line - 1, shift_world_m,
+                                                turn_world)
+            self._offsets[limb] = _Blend(self._offset(limb), dq, float(seg.first_line - 1),
+                                         float(seg.last_line - 1))
         for limb, (_j, hold) in self._next_hold[k].items():
             if seg.phase != "limb" or not self._on_ladder(hold.target):
                 continue
@@ -590,6 +604,7 @@ class MotionLayer:
         palm = self.estimate.palm_m[g.side]
         self._verified_segments.add((g.segment, g.side))
         self._settle_offset(limb)
+        self._hold_where_held(g.side)
         off = palm - g.planned_m
         self._event(MotionEventKind.GRASP_VERIFIED, limb, 0.0,
                     f"fingers at {self.estimate.finger_curl_rad[g.side]:.2f} rad on {g.rail}; "
@@ -610,6 +625,25 @@ class MotionLayer:
                         f"cm, yawed {np.degrees(self.ladder.yaw_rad):.1f}°")
         self._regrasp = None
         self.player.resume(self._now)
+
+    def _hold_where_held(self, side: str) -> None:
+        """Keep a verified grasp's arm reference where its hand holds, from the encoders:
+        the palm's pose in the pelvis frame against the plan's at this line, as a world
+        shift and turn (bounded) that every later segment's offset realises at its own
+        pose while the hand holds (`_enter_segment`)."""
+        frame = self.model.chains[f"{side}_hand"].frame
+        q_plan = self.trajectory_rad[self._line]
+        T_plan = self.model.frame_in_pelvis(q_plan, frame)
+        T_held = self.model.frame_in_pelvis(self._sensed_q, frame)
+        R_wp = self.estimate.T_world_pelvis[:3, :3]
+        shift_world_m = self._bounded(R_wp @ (T_held[:3, 3] - T_plan[:3, 3]))
+        turn_pelvis = T_held[:3, :3] @ T_plan[:3, :3].T
+        angle = float(np.arccos(np.clip((np.trace(turn_pelvis) - 1.0) / 2.0, -1.0, 1.0)))
+        cap = self.config.max_reach_correction_rad
+        if angle > cap:
+            turn_pelvis = Rotation.from_rotvec(
+                Rotation.from_matrix(turn_pelvis).as_rotvec() * (cap / angle)).as_matrix()
+        self._held_at[side] = (shift_world_m, R_wp @ turn_pelvis @ R_wp.T)
 
     def _stop(self, g: _Regrasp, reason: str) -> None:
         self._open_fingers.add(g.side)
@@ -780,6 +814,7 @@ class MotionLayer:
         """The command of the tick at ``now_s``, from the daemon's state sample."""
         self._now = now_s
         s = SensedState.from_sample(state_sample)
+        self._sensed_q = s.pos_rad
         self.estimate = self.estimator.update(s)
         dt = 0.0 if self._last_now is None else now_s - self._last_now
         self._last_now = now_s
