@@ -229,9 +229,8 @@ class MotionLayer:
         self._verified_segments: set[tuple[int, str]] = set()
         #: side → (rail, planned hold [m]) of a verified grasp the hand still holds
         self._held_rails: dict[str, tuple[str, np.ndarray]] = {}
-        #: side → (world shift [m], world turn) of where a verified grasp holds against
-        #: the plan's palm (`_hold_where_held`)
-        self._held_at: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+        #: holding limb → its correction as a world shift [m] and turn (`_follow_holds`)
+        self._hold_corrections: dict[str, tuple[np.ndarray, np.ndarray]] = {}
         self._sensed_q = np.asarray(trajectory_rad[0], dtype=float).copy()
         self._arrived: set[tuple[int, str]] = set()
         self._last_ref = np.asarray(trajectory_rad[0], dtype=float).copy()
@@ -345,22 +344,59 @@ class MotionLayer:
             if hold is None or hold.target != rail \
                     or np.linalg.norm(np.asarray(hold.position_m) - planned_m) > SAME_TARGET_M:
                 del self._held_rails[side]
-                self._held_at.pop(side, None)
                 continue
             self.rails.add(RailObservation(rail, planned_m, self.estimate.palm_m[side],
                                            self._rail_direction(rail)), fits_yaw=on_floor)
+
+    def _correction_at(self, limb: str, q_held_rad: np.ndarray
+                       ) -> tuple[np.ndarray, np.ndarray]:
+        """Where ``limb`` holds against the plan at this line, as a world shift [m] and
+        turn (bounded): its end frame at ``q_held_rad`` against the plan's, both in the
+        pelvis frame (encoders or references, no pose estimate but the pelvis's
+        orientation)."""
+        frame = self.model.chains[limb].frame
+        T_plan = self.model.frame_in_pelvis(self.trajectory_rad[self._line], frame)
+        T_held = self.model.frame_in_pelvis(q_held_rad, frame)
+        R_wp = self.estimate.T_world_pelvis[:3, :3]
+        turn = Rotation.from_matrix(T_held[:3, :3] @ T_plan[:3, :3].T).as_rotvec()
+        angle_rad = float(np.linalg.norm(turn))
+        cap_rad = self.config.max_reach_correction_rad
+        if angle_rad > cap_rad:
+            turn *= cap_rad / angle_rad
+        return (self._bounded(R_wp @ (T_held[:3, 3] - T_plan[:3, 3])),
+                R_wp @ Rotation.from_rotvec(turn).as_matrix() @ R_wp.T)
+
+    def _follow_holds(self, seg: Segment) -> None:
+        """Keep every holding limb's correction where it holds at this segment's poses.
+
+        A correction is a displacement of the hold (`_correction_at`): taken when the
+        limb starts to hold (from the encoders for a verified grasp, from its references
+        for a foot), it is realised by inverse kinematics at the segment's last pose and
+        blended in over the segment. A joint offset solved at one pose and kept moves the
+        end frame elsewhere at another: the body rises 30 cm past a held hand, and a foot
+        turned for the ladder's yaw was pulled against its rung by both stiff legs."""
+        for limb in seg.moving_limbs:
+            self._hold_corrections.pop(limb, None)
+        for limb in seg.holds:
+            if limb in seg.moving_limbs:
+                continue
+            if limb not in self._hold_corrections:
+                if limb not in self._offsets:
+                    continue
+                q_held = self.trajectory_rad[self._line] + self._offset(limb)
+                self._hold_corrections[limb] = self._correction_at(limb, q_held)
+            shift_world_m, turn_world = self._hold_corrections[limb]
+            dq, _residual = self._limb_shift_dq(limb, seg.last_line - 1, shift_world_m,
+                                                turn_world)
+            self._offsets[limb] = _Blend(self._offset(limb), dq, float(seg.first_line - 1),
+                                         float(seg.last_line - 1))
 
     def _enter_segment(self, k: int) -> None:
         """Measure the held rails again; re-target the reaches of segment ``k`` from the
         ladder estimate."""
         seg = self.sidecar.segments[k]
         self._observe_held_rails(seg)
-        for side, (shift_world_m, turn_world) in self._held_at.items():
-            limb = f"{side}_hand"
-            dq, _residual = self._limb_shift_dq(limb, seg.last_line - 1, shift_world_m,
-                                                turn_world)
-            self._offsets[limb] = _Blend(self._offset(limb), dq, float(seg.first_line - 1),
-                                         float(seg.last_line - 1))
+        self._follow_holds(seg)
         for limb, (_j, hold) in self._next_hold[k].items():
             if seg.phase != "limb" or not self._on_ladder(hold.target):
                 continue
@@ -604,7 +640,7 @@ class MotionLayer:
         palm = self.estimate.palm_m[g.side]
         self._verified_segments.add((g.segment, g.side))
         self._settle_offset(limb)
-        self._hold_where_held(g.side)
+        self._hold_corrections[limb] = self._correction_at(limb, self._sensed_q)
         off = palm - g.planned_m
         self._event(MotionEventKind.GRASP_VERIFIED, limb, 0.0,
                     f"fingers at {self.estimate.finger_curl_rad[g.side]:.2f} rad on {g.rail}; "
@@ -625,25 +661,6 @@ class MotionLayer:
                         f"cm, yawed {np.degrees(self.ladder.yaw_rad):.1f}°")
         self._regrasp = None
         self.player.resume(self._now)
-
-    def _hold_where_held(self, side: str) -> None:
-        """Keep a verified grasp's arm reference where its hand holds, from the encoders:
-        the palm's pose in the pelvis frame against the plan's at this line, as a world
-        shift and turn (bounded) that every later segment's offset realises at its own
-        pose while the hand holds (`_enter_segment`)."""
-        frame = self.model.chains[f"{side}_hand"].frame
-        q_plan = self.trajectory_rad[self._line]
-        T_plan = self.model.frame_in_pelvis(q_plan, frame)
-        T_held = self.model.frame_in_pelvis(self._sensed_q, frame)
-        R_wp = self.estimate.T_world_pelvis[:3, :3]
-        shift_world_m = self._bounded(R_wp @ (T_held[:3, 3] - T_plan[:3, 3]))
-        turn_pelvis = T_held[:3, :3] @ T_plan[:3, :3].T
-        angle = float(np.arccos(np.clip((np.trace(turn_pelvis) - 1.0) / 2.0, -1.0, 1.0)))
-        cap = self.config.max_reach_correction_rad
-        if angle > cap:
-            turn_pelvis = Rotation.from_rotvec(
-                Rotation.from_matrix(turn_pelvis).as_rotvec() * (cap / angle)).as_matrix()
-        self._held_at[side] = (shift_world_m, R_wp @ turn_pelvis @ R_wp.T)
 
     def _stop(self, g: _Regrasp, reason: str) -> None:
         self._open_fingers.add(g.side)
