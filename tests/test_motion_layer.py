@@ -232,6 +232,54 @@ def test_a_missed_grasp_searches_where_the_holding_hands_found_the_rails(reach):
     assert set(layer._held_rails) == {"right"}
 
 
+def test_a_held_grasp_stays_where_it_holds_as_the_arm_moves(reach):
+    """A verified grasp's correction is where its hand holds (the encoders' palm against
+    the plan's), and each later segment realises it at its own pose. The hold segment's
+    end is given another arm configuration (the raise's): there the joint offset that put
+    the palm on its hold at the grasp moves it centimetres elsewhere."""
+    from execute.motion.estimator import BodyEstimate
+    from execute.motion.layer import MotionLayer, _Regrasp
+    from execute.play.player import PlayerOptions, TrajectoryPlayer
+
+    _path, traj, sc, ladder = reach
+    grasp = next(k for k, seg in enumerate(sc.segments) if seg.phase == "grasp")
+    hold_seg = sc.segments[grasp + 1]
+    arm = [JOINT_INDEX[n] for n in ARM_JOINTS["left"]]
+    traj = traj.copy()
+    end = hold_seg.last_line - 1
+    raised = sc.segments[1].last_line - 1  # the palm beside the shoulder
+    traj[end, arm] = traj[raised, arm]
+    layer = MotionLayer(TrajectoryPlayer(traj, PlayerOptions(rate_hz=int(sc.rate_hz))),
+                        traj, sc, ladder)
+    palm = layer.model.chains["left_hand"].frame
+    planned = np.asarray(hold_seg.holds["left_hand"].position_m)
+    layer.estimate = BodyEstimate(0.0, np.eye(4), np.eye(3), {"left": True, "right": True},
+                                  {"left": planned, "right": planned}, {},
+                                  {"left": 0.09, "right": 0.09})
+    layer.player.step(0.0, traj[0])
+    layer.player.pause(0.0)
+    closed = sc.segments[grasp].last_line - 1
+    layer._line = closed
+    sensed = traj[closed].copy()
+    sensed[arm] += [0.03, -0.02, 0.02, 0.05, 0.0, -0.04, 0.0]  # the latch pulled the palm
+    layer._sensed_q = sensed
+    layer._grasp_verified(_Regrasp("left", grasp, "rail_left", planned, "verify", 0.0))
+    T_plan = layer.model.frame_in_pelvis(traj[closed], palm)
+    T_held = layer.model.frame_in_pelvis(sensed, palm)
+    layer._line = hold_seg.first_line - 1
+    layer._enter_segment(grasp + 1)
+    dq = layer._offsets["left_hand"].end
+    T_end = layer.model.frame_in_pelvis(traj[end], palm)
+    T_got = layer.model.frame_in_pelvis(traj[end] + dq, palm)
+    want_shift = T_held[:3, 3] - T_plan[:3, 3]
+    want_turn = T_held[:3, :3] @ T_plan[:3, :3].T
+    assert np.linalg.norm(want_shift) > 0.02
+    assert np.allclose(T_got[:3, 3] - T_end[:3, 3], want_shift, atol=5e-4)
+    assert np.allclose(T_got[:3, :3] @ T_end[:3, :3].T, want_turn, atol=5e-3)
+    kept = layer.model.frame_in_pelvis(traj[end] + sensed - traj[closed], palm)
+    assert np.linalg.norm(kept[:3, 3] - T_end[:3, 3] - want_shift) > 0.01
+
+
 @pytest.mark.parametrize("field,value", [("max_reach_correction_m", 0.2),
                                          ("grasp_retries", -1),
                                          ("max_reach_correction_rad", 1.0),
