@@ -280,6 +280,43 @@ def test_a_held_grasp_stays_where_it_holds_as_the_arm_moves(reach):
     assert np.linalg.norm(kept[:3, 3] - T_end[:3, 3] - want_shift) > 0.01
 
 
+def test_a_standing_foots_correction_stays_where_it_stands_as_the_leg_moves(reach):
+    """A foot's reach correction, once the foot stands, is kept as the displacement its
+    references gave it there (turn included: the ladder's yaw), realised at each later
+    pose; not as the joint offset, which at a bent knee turns and moves the sole."""
+    from execute.motion.estimator import BodyEstimate
+    from execute.motion.layer import MotionLayer, _Blend
+    from execute.play.player import PlayerOptions, TrajectoryPlayer
+
+    _path, traj, sc, ladder = reach
+    k = len(sc.segments) - 1
+    seg = sc.segments[k]
+    leg = [JOINT_INDEX[n] for n in ("LHP", "LKN", "LAP")]
+    traj = traj.copy()
+    end = seg.last_line - 1
+    traj[end, leg] += [-0.5, 1.0, -0.5]  # a crouch: the sole stays flat below the hip
+    layer = MotionLayer(TrajectoryPlayer(traj, PlayerOptions(rate_hz=int(sc.rate_hz))),
+                        traj, sc, ladder)
+    layer.estimate = BodyEstimate(0.0, np.eye(4), np.eye(3), {"left": True, "right": True},
+                                  {}, {}, {"left": 0.0, "right": 0.0})
+    layer._line = start = seg.first_line - 1
+    shift = np.array([0.02, -0.01, 0.0])
+    yaw = np.radians(2.0)
+    turn = np.array([[np.cos(yaw), -np.sin(yaw), 0.0], [np.sin(yaw), np.cos(yaw), 0.0],
+                     [0.0, 0.0, 1.0]])
+    dq0, _ = layer._limb_shift_dq("left_foot", start, shift, turn)
+    layer._offsets["left_foot"] = _Blend(dq0, dq0, float(start), float(start))
+    layer._follow_holds(seg)
+    dq = layer._offsets["left_foot"].end
+    sole = layer.model.chains["left_foot"].frame
+    T_end = layer.model.frame_in_pelvis(traj[end], sole)
+    T_got = layer.model.frame_in_pelvis(traj[end] + dq, sole)
+    assert np.allclose(T_got[:3, 3] - T_end[:3, 3], shift, atol=5e-4)
+    assert np.allclose(T_got[:3, :3] @ T_end[:3, :3].T, turn, atol=5e-3)
+    kept = layer.model.frame_in_pelvis(traj[end] + dq0, sole)
+    assert np.linalg.norm(kept[:3, 3] - T_end[:3, 3] - shift) > 0.002
+
+
 @pytest.mark.parametrize("field,value", [("max_reach_correction_m", 0.2),
                                          ("grasp_retries", -1),
                                          ("max_reach_correction_rad", 1.0),
