@@ -120,6 +120,12 @@ def _side(limb: str) -> str:
     return limb.split("_")[0]
 
 
+def _yaw_matrix(yaw_rad: float) -> np.ndarray:
+    """The rotation by ``yaw_rad`` about the world's z axis."""
+    c, s = np.cos(yaw_rad), np.sin(yaw_rad)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
 @dataclass
 class _Blend:
     """A limb's joint offset moving from ``start`` to ``end`` between two lines (or two
@@ -232,6 +238,9 @@ class MotionLayer:
         #: holding limb → its correction as a world shift [m] and turn (`_follow_holds`)
         self._hold_corrections: dict[str, tuple[np.ndarray, np.ndarray]] = {}
         self._sensed_q = np.asarray(trajectory_rad[0], dtype=float).copy()
+        #: no foot of this segment stands on the floor: the body takes the ladder's
+        #: placement (`_body_shift_m`)
+        self._body_on_ladder = False
         self._arrived: set[tuple[int, str]] = set()
         self._last_ref = np.asarray(trajectory_rad[0], dtype=float).copy()
         self._regrasp: _Regrasp | None = None
@@ -297,13 +306,12 @@ class MotionLayer:
     def _limb_shift_dq(self, limb: str, line_index: int, shift_world_m: np.ndarray,
                        turn_world: np.ndarray | None = None) -> tuple[np.ndarray, float]:
         """Joint offsets that move ``limb`` by ``shift_world_m`` and turn it by
-        ``turn_world`` (world frame; the ladder estimate's yaw when None) at the plan's
-        pose of ``line_index``."""
+        ``turn_world`` (world frame; when None, the ladder estimate's yaw less the body's,
+        `_body_yaw_rad`) at the plan's pose of ``line_index``."""
         R_world_pelvis = self.estimate.T_world_pelvis[:3, :3]
         if turn_world is None:
-            yaw = self.ladder.yaw_rad
-            c, s = np.cos(yaw), np.sin(yaw)
-            turn_world = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+            yaw = (self.ladder.yaw_rad if self.ladder.observed else 0.0) - self._body_yaw_rad()
+            turn_world = _yaw_matrix(yaw)
         return self.model.limb_correction(self.trajectory_rad[line_index],
                                           self.model.chains[limb],
                                           R_world_pelvis.T @ shift_world_m,
@@ -318,6 +326,30 @@ class MotionLayer:
         if not estimate.observed:
             return np.zeros(3)
         shift = self._bounded(estimate.correction_m(planned_m))
+        return shift if float(np.linalg.norm(shift)) >= MIN_CORRECTION_M else np.zeros(3)
+
+    def _body_shift_m(self, planned_m: np.ndarray) -> np.ndarray:
+        """How far the body's own placement moves a hold planned at ``planned_m`` [m]:
+        nothing while a foot stands on the floor (the plan's posture over the floor
+        feet); once the ladder alone carries the robot, the ladder estimate's shift
+        there, so that the body keeps the plan's posture relative to the ladder."""
+        if not self._body_on_ladder or not self.ladder.observed:
+            return np.zeros(3)
+        return self._bounded(self.ladder.correction_m(planned_m))
+
+    def _body_yaw_rad(self) -> float:
+        """The yaw of the body's own placement (`_body_shift_m`) [rad]."""
+        return self.ladder.yaw_rad if self._body_on_ladder and self.ladder.observed else 0.0
+
+    def _target_shift(self, planned_m: np.ndarray,
+                      estimate: LadderEstimate | None = None) -> np.ndarray:
+        """A limb's correction towards a hold planned at ``planned_m``, relative to the
+        body (`_ladder_shift` less `_body_shift_m`) [m]: zero below `MIN_CORRECTION_M`,
+        bounded above."""
+        estimate = self.ladder if estimate is None else estimate
+        if not estimate.observed:
+            return np.zeros(3)
+        shift = self._bounded(estimate.correction_m(planned_m) - self._body_shift_m(planned_m))
         return shift if float(np.linalg.norm(shift)) >= MIN_CORRECTION_M else np.zeros(3)
 
     def _bounded(self, shift_m: np.ndarray) -> np.ndarray:
@@ -348,10 +380,11 @@ class MotionLayer:
             self.rails.add(RailObservation(rail, planned_m, self.estimate.palm_m[side],
                                            self._rail_direction(rail)), fits_yaw=on_floor)
 
-    def _correction_at(self, limb: str, q_held_rad: np.ndarray
+    def _correction_at(self, limb: str, q_held_rad: np.ndarray, planned_m: np.ndarray
                        ) -> tuple[np.ndarray, np.ndarray]:
         """Where ``limb`` holds against the plan at this line, as a world shift [m] and
-        turn (bounded): its end frame at ``q_held_rad`` against the plan's, both in the
+        turn (bounded), the body's own placement included (`_body_shift_m` at its hold
+        ``planned_m``): its end frame at ``q_held_rad`` against the plan's, both in the
         pelvis frame (encoders or references, no pose estimate but the pelvis's
         orientation)."""
         frame = self.model.chains[limb].frame
@@ -363,31 +396,38 @@ class MotionLayer:
         cap_rad = self.config.max_reach_correction_rad
         if angle_rad > cap_rad:
             turn *= cap_rad / angle_rad
-        return (self._bounded(R_wp @ (T_held[:3, 3] - T_plan[:3, 3])),
-                R_wp @ Rotation.from_rotvec(turn).as_matrix() @ R_wp.T)
+        return (self._bounded(R_wp @ (T_held[:3, 3] - T_plan[:3, 3]))
+                + self._body_shift_m(planned_m),
+                R_wp @ Rotation.from_rotvec(turn).as_matrix() @ R_wp.T
+                @ _yaw_matrix(self._body_yaw_rad()))
 
     def _follow_holds(self, seg: Segment) -> None:
         """Keep every holding limb's correction where it holds at this segment's poses.
 
-        A correction is a displacement of the hold (`_correction_at`): taken when the
-        limb starts to hold (from the encoders for a verified grasp, from its references
-        for a foot), it is realised by inverse kinematics at the segment's last pose and
-        blended in over the segment. A joint offset solved at one pose and kept moves the
-        end frame elsewhere at another: the body rises 30 cm past a held hand, and a foot
-        turned for the ladder's yaw was pulled against its rung by both stiff legs."""
+        A correction is a displacement of the hold in the world (`_correction_at`): taken
+        when the limb starts to hold (from the encoders for a verified grasp, from its
+        references for a foot), it is realised, less the body's own placement
+        (`_body_shift_m`), by inverse kinematics at the segment's last pose and blended
+        in over the segment. A joint offset solved at one pose and kept moves the end
+        frame elsewhere at another: the body rises 30 cm past a held hand, and a foot
+        turned for the ladder's yaw was pulled against its rung by both stiff legs. Once
+        the last foot leaves the floor, the body takes the ladder's placement and the
+        holds on the ladder need no correction of their own."""
         for limb in seg.moving_limbs:
             self._hold_corrections.pop(limb, None)
-        for limb in seg.holds:
+        for limb, hold in seg.holds.items():
             if limb in seg.moving_limbs:
                 continue
+            planned_m = np.asarray(hold.position_m)
             if limb not in self._hold_corrections:
                 if limb not in self._offsets:
                     continue
                 q_held = self.trajectory_rad[self._line] + self._offset(limb)
-                self._hold_corrections[limb] = self._correction_at(limb, q_held)
+                self._hold_corrections[limb] = self._correction_at(limb, q_held, planned_m)
             shift_world_m, turn_world = self._hold_corrections[limb]
-            dq, _residual = self._limb_shift_dq(limb, seg.last_line - 1, shift_world_m,
-                                                turn_world)
+            dq, _residual = self._limb_shift_dq(
+                limb, seg.last_line - 1, shift_world_m - self._body_shift_m(planned_m),
+                turn_world @ _yaw_matrix(self._body_yaw_rad()).T)
             self._offsets[limb] = _Blend(self._offset(limb), dq, float(seg.first_line - 1),
                                          float(seg.last_line - 1))
 
@@ -396,11 +436,13 @@ class MotionLayer:
         ladder estimate."""
         seg = self.sidecar.segments[k]
         self._observe_held_rails(seg)
+        self._body_on_ladder = not any(limb.endswith("_foot") and h.target == "floor"
+                                       for limb, h in seg.holds.items())
         self._follow_holds(seg)
         for limb, (_j, hold) in self._next_hold[k].items():
             if seg.phase != "limb" or not self._on_ladder(hold.target):
                 continue
-            shift = self._ladder_shift(np.asarray(hold.position_m))
+            shift = self._target_shift(np.asarray(hold.position_m))
             if not shift.any():
                 if limb not in self._offsets:
                     continue
@@ -441,7 +483,7 @@ class MotionLayer:
             return _Regrasp(side, k, rail, planned, "verify", self._now)
         if line_index == seg.first_line - 1 and (k, side) not in self._arrived:
             limb = f"{side}_hand"
-            wanted = self._ladder_shift(planned)
+            wanted = self._target_shift(planned)
             if np.linalg.norm(wanted - self._shift_m.get(limb, np.zeros(3))) > SAME_TARGET_M:
                 g = _Regrasp(side, k, rail, planned, "retarget", self._now)
                 self._move_hand(g, wanted, "the ladder estimate moved its target")
@@ -463,11 +505,12 @@ class MotionLayer:
         across the rail (where the palm closed against where it was sent), then a pattern
         around the first. Each within the bound and different from where the hand closed
         last and from the others."""
-        centre = self._ladder_shift(g.planned_m, self.rails)
+        centre = self._target_shift(g.planned_m, self.rails)
         towards_ladder = -self.geometry.rung_line_normal
         step = self.config.search_step_m
         current = self._shift_m.get(f"{g.side}_hand", np.zeros(3))
-        miss = self._across_rail(g, self.estimate.palm_m[g.side] - (g.planned_m + current))
+        sent_m = g.planned_m + self._body_shift_m(g.planned_m) + current
+        miss = self._across_rail(g, self.estimate.palm_m[g.side] - sent_m)
         pattern = [self._bounded(centre + step * (across * towards_ladder
                                                   + lateral * self.geometry.lateral_direction))
                    for across, lateral in SEARCH_PATTERN]
@@ -640,7 +683,7 @@ class MotionLayer:
         palm = self.estimate.palm_m[g.side]
         self._verified_segments.add((g.segment, g.side))
         self._settle_offset(limb)
-        self._hold_corrections[limb] = self._correction_at(limb, self._sensed_q)
+        self._hold_corrections[limb] = self._correction_at(limb, self._sensed_q, g.planned_m)
         off = palm - g.planned_m
         self._event(MotionEventKind.GRASP_VERIFIED, limb, 0.0,
                     f"fingers at {self.estimate.finger_curl_rad[g.side]:.2f} rad on {g.rail}; "
