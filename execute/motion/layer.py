@@ -49,8 +49,12 @@ hubo-motion-rt and the thesis's operator did (thesis §4.3.4, §6.2):
   (`execute.motion.ladder_estimate`); every later reach of a hand or a foot to a hold on
   the ladder is re-targeted by that estimate, by inverse kinematics on the limb's chain
   from the plan's end pose of the reach (`execute.motion.robot_model`), blended in over
-  the reach and kept while the limb holds. Corrections are bounded
-  (`MotionConfig.max_reach_correction_m`).
+  the reach. Corrections are bounded (`MotionConfig.max_reach_correction_m`);
+- **holds kept where they are**: while a limb holds, its correction is a displacement of
+  its hold (a verified grasp's from the encoders), realised again at each segment's pose
+  (`_follow_holds`). While a foot stands on the floor the body keeps the plan's posture
+  over the floor; once none does, the body takes the ladder's placement and the holds on
+  the ladder need no correction of their own (`_body_shift_m`).
 
 Its only input is the daemon's state struct (`execute.motion.sensed_state`). It writes
 references, modes and feed-forward, the same things the open-loop player writes.
