@@ -232,89 +232,66 @@ def test_a_missed_grasp_searches_where_the_holding_hands_found_the_rails(reach):
     assert set(layer._held_rails) == {"right"}
 
 
-def test_a_held_grasp_stays_where_it_holds_as_the_arm_moves(reach):
-    """A verified grasp's correction is where its hand holds (the encoders' palm against
-    the plan's), and each later segment realises it at its own pose. The hold segment's
-    end is given another arm configuration (the raise's): there the joint offset that put
-    the palm on its hold at the grasp moves it centimetres elsewhere."""
-    from execute.motion.estimator import BodyEstimate
-    from execute.motion.layer import MotionLayer, _Regrasp
-    from execute.play.player import PlayerOptions, TrajectoryPlayer
-
-    _path, traj, sc, ladder = reach
-    grasp = next(k for k, seg in enumerate(sc.segments) if seg.phase == "grasp")
-    hold_seg = sc.segments[grasp + 1]
-    arm = [JOINT_INDEX[n] for n in ARM_JOINTS["left"]]
-    traj = traj.copy()
-    end = hold_seg.last_line - 1
-    raised = sc.segments[1].last_line - 1  # the palm beside the shoulder
-    traj[end, arm] = traj[raised, arm]
-    layer = MotionLayer(TrajectoryPlayer(traj, PlayerOptions(rate_hz=int(sc.rate_hz))),
-                        traj, sc, ladder)
-    palm = layer.model.chains["left_hand"].frame
-    planned = np.asarray(hold_seg.holds["left_hand"].position_m)
-    layer.estimate = BodyEstimate(0.0, np.eye(4), np.eye(3), {"left": True, "right": True},
-                                  {"left": planned, "right": planned}, {},
-                                  {"left": 0.09, "right": 0.09})
-    layer.player.step(0.0, traj[0])
-    layer.player.pause(0.0)
-    closed = sc.segments[grasp].last_line - 1
-    layer._line = closed
-    sensed = traj[closed].copy()
-    sensed[arm] += [0.03, -0.02, 0.02, 0.05, 0.0, -0.04, 0.0]  # the latch pulled the palm
-    layer._sensed_q = sensed
-    layer._grasp_verified(_Regrasp("left", grasp, "rail_left", planned, "verify", 0.0))
-    T_plan = layer.model.frame_in_pelvis(traj[closed], palm)
-    T_held = layer.model.frame_in_pelvis(sensed, palm)
-    layer._line = hold_seg.first_line - 1
-    layer._enter_segment(grasp + 1)
-    dq = layer._offsets["left_hand"].end
-    T_end = layer.model.frame_in_pelvis(traj[end], palm)
-    T_got = layer.model.frame_in_pelvis(traj[end] + dq, palm)
-    want_shift = T_held[:3, 3] - T_plan[:3, 3]
-    want_turn = T_held[:3, :3] @ T_plan[:3, :3].T
-    assert np.linalg.norm(want_shift) > 0.02
-    assert np.allclose(T_got[:3, 3] - T_end[:3, 3], want_shift, atol=5e-4)
-    assert np.allclose(T_got[:3, :3] @ T_end[:3, :3].T, want_turn, atol=5e-3)
-    kept = layer.model.frame_in_pelvis(traj[end] + sensed - traj[closed], palm)
-    assert np.linalg.norm(kept[:3, 3] - T_end[:3, 3] - want_shift) > 0.01
-
-
-def test_a_standing_foots_correction_stays_where_it_stands_as_the_leg_moves(reach):
-    """A foot's reach correction, once the foot stands, is kept as the displacement its
-    references gave it there (turn included: the ladder's yaw), realised at each later
-    pose; not as the joint offset, which at a bent knee turns and moves the sole."""
+@pytest.mark.parametrize("limb,joints,change_rad", [
+    ("left_foot", ("LHP", "LKN", "LAP"), (-0.5, 1.0, -0.5)),  # a crouch, the sole flat
+    ("left_hand", ("LSP", "LSR", "LEB"), (-0.3, -0.4, 0.5)),  # the body rising past it
+])
+def test_a_holding_limbs_correction_stays_where_it_holds(reach, limb, joints, change_rad):
+    """A limb's correction, once it holds, is kept as the displacement its references
+    gave it there (a shift, and a turn: the ladder's yaw), realised at each later pose;
+    not as the joint offset, which at another pose moves and turns the end frame
+    elsewhere."""
     from execute.motion.estimator import BodyEstimate
     from execute.motion.layer import MotionLayer, _Blend
     from execute.play.player import PlayerOptions, TrajectoryPlayer
 
     _path, traj, sc, ladder = reach
-    k = len(sc.segments) - 1
-    seg = sc.segments[k]
-    leg = [JOINT_INDEX[n] for n in ("LHP", "LKN", "LAP")]
+    seg = sc.segments[-1]
+    assert limb in seg.holds and limb not in seg.moving_limbs
     traj = traj.copy()
     end = seg.last_line - 1
-    traj[end, leg] += [-0.5, 1.0, -0.5]  # a crouch: the sole stays flat below the hip
+    traj[end, [JOINT_INDEX[n] for n in joints]] += change_rad
     layer = MotionLayer(TrajectoryPlayer(traj, PlayerOptions(rate_hz=int(sc.rate_hz))),
                         traj, sc, ladder)
     layer.estimate = BodyEstimate(0.0, np.eye(4), np.eye(3), {"left": True, "right": True},
                                   {}, {}, {"left": 0.0, "right": 0.0})
     layer._line = start = seg.first_line - 1
-    shift = np.array([0.02, -0.01, 0.0])
+    shift = np.array([0.02, -0.01, 0.01])
     yaw = np.radians(2.0)
     turn = np.array([[np.cos(yaw), -np.sin(yaw), 0.0], [np.sin(yaw), np.cos(yaw), 0.0],
                      [0.0, 0.0, 1.0]])
-    dq0, _ = layer._limb_shift_dq("left_foot", start, shift, turn)
-    layer._offsets["left_foot"] = _Blend(dq0, dq0, float(start), float(start))
+    dq0, _ = layer._limb_shift_dq(limb, start, shift, turn)
+    layer._offsets[limb] = _Blend(dq0, dq0, float(start), float(start))
     layer._follow_holds(seg)
-    dq = layer._offsets["left_foot"].end
-    sole = layer.model.chains["left_foot"].frame
-    T_end = layer.model.frame_in_pelvis(traj[end], sole)
-    T_got = layer.model.frame_in_pelvis(traj[end] + dq, sole)
+    dq = layer._offsets[limb].end
+    frame = layer.model.chains[limb].frame
+    T_end = layer.model.frame_in_pelvis(traj[end], frame)
+    T_got = layer.model.frame_in_pelvis(traj[end] + dq, frame)
     assert np.allclose(T_got[:3, 3] - T_end[:3, 3], shift, atol=5e-4)
     assert np.allclose(T_got[:3, :3] @ T_end[:3, :3].T, turn, atol=5e-3)
-    kept = layer.model.frame_in_pelvis(traj[end] + dq0, sole)
-    assert np.linalg.norm(kept[:3, 3] - T_end[:3, 3] - shift) > 0.002
+    kept = layer.model.frame_in_pelvis(traj[end] + dq0, frame)  # the offset, kept
+    assert not (np.allclose(kept[:3, 3] - T_end[:3, 3], shift, atol=5e-4)
+                and np.allclose(kept[:3, :3] @ T_end[:3, :3].T, turn, atol=5e-3))
+
+
+def test_once_off_the_floor_the_body_takes_the_ladders_placement(reach):
+    """While a foot stands on the floor a hold on the ladder is reached where the ladder
+    estimate puts it; once no foot does, the body takes the ladder's placement and the
+    same hold needs no correction of its own."""
+    from execute.motion.layer import MotionLayer
+    from execute.play.player import PlayerOptions, TrajectoryPlayer
+
+    _path, traj, sc, ladder = reach
+    layer = MotionLayer(TrajectoryPlayer(traj, PlayerOptions(rate_hz=int(sc.rate_hz))),
+                        traj, sc, ladder)
+    hold = np.asarray(sc.segments[-1].holds["left_hand"].position_m)
+    layer.ladder.add(RailObservation("rail_left", hold, hold + [-0.03, 0.0, 0.0],
+                                     layer._rail_direction("rail_left")))
+    on_floor = layer._target_shift(hold)
+    assert np.linalg.norm(on_floor) > 0.02
+    layer._body_on_ladder = True
+    assert np.allclose(layer._target_shift(hold), 0.0)
+    assert np.allclose(layer._body_shift_m(hold), on_floor)
 
 
 @pytest.mark.parametrize("field,value", [("max_reach_correction_m", 0.2),

@@ -241,7 +241,6 @@ class MotionLayer:
         self._held_rails: dict[str, tuple[str, np.ndarray]] = {}
         #: holding limb → its correction as a world shift [m] and turn (`_follow_holds`)
         self._hold_corrections: dict[str, tuple[np.ndarray, np.ndarray]] = {}
-        self._sensed_q = np.asarray(trajectory_rad[0], dtype=float).copy()
         #: no foot of this segment stands on the floor: the body takes the ladder's
         #: placement (`_body_shift_m`)
         self._body_on_ladder = False
@@ -386,11 +385,10 @@ class MotionLayer:
 
     def _correction_at(self, limb: str, q_held_rad: np.ndarray, planned_m: np.ndarray
                        ) -> tuple[np.ndarray, np.ndarray]:
-        """Where ``limb`` holds against the plan at this line, as a world shift [m] and
-        turn (bounded), the body's own placement included (`_body_shift_m` at its hold
-        ``planned_m``): its end frame at ``q_held_rad`` against the plan's, both in the
-        pelvis frame (encoders or references, no pose estimate but the pelvis's
-        orientation)."""
+        """Where ``limb``'s references ``q_held_rad`` put it against the plan at this line,
+        as a world shift [m] and turn (bounded), the body's own placement included
+        (`_body_shift_m` at its hold ``planned_m``): its end frame against the plan's,
+        both in the pelvis frame."""
         frame = self.model.chains[limb].frame
         T_plan = self.model.frame_in_pelvis(self.trajectory_rad[self._line], frame)
         T_held = self.model.frame_in_pelvis(q_held_rad, frame)
@@ -409,8 +407,8 @@ class MotionLayer:
         """Keep every holding limb's correction where it holds at this segment's poses.
 
         A correction is a displacement of the hold in the world (`_correction_at`): taken
-        when the limb starts to hold (from the encoders for a verified grasp, from its
-        references for a foot), it is realised, less the body's own placement
+        from the limb's references when it starts to hold, it is realised, less the
+        body's own placement
         (`_body_shift_m`), by inverse kinematics at the segment's last pose and blended
         in over the segment. A joint offset solved at one pose and kept moves the end
         frame elsewhere at another: the body rises 30 cm past a held hand, and a foot
@@ -687,7 +685,6 @@ class MotionLayer:
         palm = self.estimate.palm_m[g.side]
         self._verified_segments.add((g.segment, g.side))
         self._settle_offset(limb)
-        self._hold_corrections[limb] = self._correction_at(limb, self._sensed_q, g.planned_m)
         off = palm - g.planned_m
         self._event(MotionEventKind.GRASP_VERIFIED, limb, 0.0,
                     f"fingers at {self.estimate.finger_curl_rad[g.side]:.2f} rad on {g.rail}; "
@@ -878,7 +875,6 @@ class MotionLayer:
         """The command of the tick at ``now_s``, from the daemon's state sample."""
         self._now = now_s
         s = SensedState.from_sample(state_sample)
-        self._sensed_q = s.pos_rad
         self.estimate = self.estimator.update(s)
         dt = 0.0 if self._last_now is None else now_s - self._last_now
         self._last_now = now_s
