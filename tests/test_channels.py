@@ -133,6 +133,21 @@ def test_wait_newer_times_out_and_wakes(instance, in_process):
     w.close()
 
 
+def _wait_for_a_later_write(r, w, k: int, delay_s: float, stamp: int) -> int:
+    """``w`` writes value ``k`` after ``delay_s`` from a timer thread while ``r`` waits (up
+    to 10 s) for a sample newer than ``stamp``; the reader must get it within 5 s (with
+    ``WAKE_SLICE_S`` pushed out, only a wake-up gets it there). Returns its stamp."""
+    timer = threading.Timer(delay_s, w.write, args=(_ref(float(k)),))
+    timer.start()
+    t0 = time.monotonic()
+    got = r.wait_newer(stamp, 10.0)
+    waited_s = time.monotonic() - t0
+    timer.join()
+    assert got is not None and float(got["ref"][0]) == k
+    assert waited_s < 5.0, f"write {k} did not wake the reader"
+    return int(got["time_ns"])
+
+
 def test_a_blocked_reader_is_woken_by_each_write_not_by_its_re_check(instance, monkeypatch):
     """Every write wakes a blocked shared-memory reader: with the periodic re-check pushed
     out to 30 s, a lost wake-up leaves ``wait_newer`` asleep for its whole 10 s timeout
@@ -143,15 +158,42 @@ def test_a_blocked_reader_is_woken_by_each_write_not_by_its_re_check(instance, m
     stamp = w.write(_ref(0.0))
     delays = np.random.default_rng(0).uniform(0.0, 0.002, 200)
     for k, delay in enumerate(delays, start=1):
-        timer = threading.Timer(delay, w.write, args=(_ref(float(k)),))
-        timer.start()
-        t0 = time.monotonic()
-        got = r.wait_newer(stamp, 10.0)
-        waited_s = time.monotonic() - t0
-        timer.join()
-        assert got is not None and float(got["ref"][0]) == k
-        assert waited_s < 5.0, f"write {k} did not wake the reader"
-        stamp = int(got["time_ns"])
+        stamp = _wait_for_a_later_write(r, w, k, delay, stamp)
+    r.close()
+    w.close()
+
+
+def test_a_reader_woken_before_the_publish_gets_the_sample_if_the_writer_stalls(
+    instance, monkeypatch
+):
+    """A writer wakes blocked readers before it copies and publishes; a reader so woken
+    polls for the publish for `SPIN_AFTER_WAKE_NS`, then sleeps again. Here the writer
+    stalls 20 ms between that early wake and its publish, far past the poll: the reader
+    still gets the sample, woken by the writer's second wake after the publish (the
+    periodic re-check is pushed out to 30 s, so a lost wake-up would leave ``wait_newer``
+    asleep for its whole 10 s timeout)."""
+    monkeypatch.setattr(ch, "WAKE_SLICE_S", 30.0)
+    wake, sleep = ch._futex_wake_all, ch._futex_wait
+    sleeps_woken = []  # per futex sleep of the reader: ended by a wake?
+
+    def wake_then_stall(addr):
+        wake(addr)
+        time.sleep(0.02)
+
+    def recorded_sleep(*args):
+        sleeps_woken.append(sleep(*args))
+        return sleeps_woken[-1]
+
+    monkeypatch.setattr(ch, "_futex_wake_all", wake_then_stall)
+    monkeypatch.setattr(ch, "_futex_wait", recorded_sleep)
+    r, w = ShmChannel("ref", instance), ShmChannel("ref", instance)
+    stamp = w.write(_ref(0.0))
+    for k in range(1, 4):
+        sleeps_woken.clear()
+        stamp = _wait_for_a_later_write(r, w, k, 0.1, stamp)
+        # Woken early, gave up its poll, slept again, woken again (or, if the publish
+        # came first, found the generation changed).
+        assert sleeps_woken[0] and len(sleeps_woken) >= 2
     r.close()
     w.close()
 
