@@ -23,7 +23,8 @@ from robot.vocabulary import SIDES
 _SIDE_SIGN = {"left": 1.0, "right": -1.0}  # left = +y_L
 
 
-def _rot_z(angle_rad: float) -> np.ndarray:
+def rot_z(angle_rad: float) -> np.ndarray:
+    """The rotation by ``angle_rad`` about the z axis."""
     c, s = math.cos(angle_rad), math.sin(angle_rad)
     return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
@@ -113,7 +114,7 @@ class LadderGeometry:
     def T_world_ladder(self) -> np.ndarray:
         """4×4 pose of the ladder frame L in the world frame (the placement)."""
         s = self.spec
-        return make_transform(_rot_z(s.placement_yaw_rad),
+        return make_transform(rot_z(s.placement_yaw_rad),
                               np.array([s.placement_x_m, s.placement_y_m, 0.0]))
 
     @property
@@ -359,4 +360,4 @@ def ladder_geometry(spec: LadderSpec) -> LadderGeometry:
     return LadderGeometry(spec)
 
 
-__all__ = ["SIDES", "LadderGeometry", "Solid", "ladder_geometry", "make_transform"]
+__all__ = ["SIDES", "LadderGeometry", "Solid", "ladder_geometry", "make_transform", "rot_z"]

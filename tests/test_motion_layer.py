@@ -287,10 +287,10 @@ def test_once_off_the_floor_the_body_takes_the_ladders_placement(reach):
     hold = np.asarray(sc.segments[-1].holds["left_hand"].position_m)
     layer.ladder.add(RailObservation("rail_left", hold, hold + [-0.03, 0.0, 0.0],
                                      layer._rail_direction("rail_left")))
-    on_floor = layer._target_shift(hold)
+    on_floor = layer._ladder_shift(hold)
     assert np.linalg.norm(on_floor) > 0.02
     layer._body_on_ladder = True
-    assert np.allclose(layer._target_shift(hold), 0.0)
+    assert np.allclose(layer._ladder_shift(hold), 0.0)
     assert np.allclose(layer._body_shift_m(hold), on_floor)
 
 

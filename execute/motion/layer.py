@@ -51,7 +51,7 @@ hubo-motion-rt and the thesis's operator did (thesis §4.3.4, §6.2):
   from the plan's end pose of the reach (`execute.motion.robot_model`), blended in over
   the reach. Corrections are bounded (`MotionConfig.max_reach_correction_m`);
 - **holds kept where they are**: while a limb holds, its correction is a displacement of
-  its hold (a verified grasp's from the encoders), realised again at each segment's pose
+  its hold (from its references as it starts to hold), realised again at each segment's pose
   (`_follow_holds`). While a foot stands on the floor the body keeps the plan's posture
   over the floor; once none does, the body takes the ladder's placement and the holds on
   the ladder need no correction of their own (`_body_shift_m`).
@@ -86,7 +86,7 @@ from execute.motion.robot_model import MotionRobotModel
 from execute.motion.sensed_state import SensedState
 from execute.motion.wrist_relief import WRIST_ROLL, WristRelief
 from execute.play.player import PlayerTick, TrajectoryPlayer, min_jerk
-from ladders.geometry import LadderGeometry
+from ladders.geometry import LadderGeometry, rot_z
 from ladders.spec import LadderSpec
 from robot.joints import ARM_JOINTS, FINGER_JOINTS, JOINT_NAMES, joint_indices
 from robot.limits import joint_limits
@@ -122,12 +122,6 @@ STIFF_ARM_YIELD_S = 0.2
 
 def _side(limb: str) -> str:
     return limb.split("_")[0]
-
-
-def _yaw_matrix(yaw_rad: float) -> np.ndarray:
-    """The rotation by ``yaw_rad`` about the world's z axis."""
-    c, s = np.cos(yaw_rad), np.sin(yaw_rad)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
 @dataclass
@@ -313,22 +307,25 @@ class MotionLayer:
         `_body_yaw_rad`) at the plan's pose of ``line_index``."""
         R_world_pelvis = self.estimate.T_world_pelvis[:3, :3]
         if turn_world is None:
-            yaw = (self.ladder.yaw_rad if self.ladder.observed else 0.0) - self._body_yaw_rad()
-            turn_world = _yaw_matrix(yaw)
+            turn_world = rot_z(self.ladder.yaw_rad - self._body_yaw_rad())
         return self.model.limb_correction(self.trajectory_rad[line_index],
                                           self.model.chains[limb],
                                           R_world_pelvis.T @ shift_world_m,
                                           R_world_pelvis.T @ turn_world @ R_world_pelvis)
 
-    def _ladder_shift(self, planned_m: np.ndarray,
-                      estimate: LadderEstimate | None = None) -> np.ndarray:
+    def _ladder_shift(self, planned_m: np.ndarray, estimate: LadderEstimate | None = None,
+                      relative_to_body: bool = True) -> np.ndarray:
         """Where ``estimate`` (the ladder estimate unless given) puts a hold planned at
-        ``planned_m``, as a shift [m]: zero without an estimate or below
-        `MIN_CORRECTION_M`, bounded above."""
+        ``planned_m``, as a shift [m]: a limb's correction towards it, less the body's own
+        placement (`_body_shift_m`) unless ``relative_to_body`` is False. Zero without an
+        estimate or below `MIN_CORRECTION_M`, bounded above."""
         estimate = self.ladder if estimate is None else estimate
         if not estimate.observed:
             return np.zeros(3)
-        shift = self._bounded(estimate.correction_m(planned_m))
+        shift = estimate.correction_m(planned_m)
+        if relative_to_body:
+            shift = shift - self._body_shift_m(planned_m)
+        shift = self._bounded(shift)
         return shift if float(np.linalg.norm(shift)) >= MIN_CORRECTION_M else np.zeros(3)
 
     def _body_shift_m(self, planned_m: np.ndarray) -> np.ndarray:
@@ -336,24 +333,13 @@ class MotionLayer:
         nothing while a foot stands on the floor (the plan's posture over the floor
         feet); once the ladder alone carries the robot, the ladder estimate's shift
         there, so that the body keeps the plan's posture relative to the ladder."""
-        if not self._body_on_ladder or not self.ladder.observed:
+        if not self._body_on_ladder:
             return np.zeros(3)
         return self._bounded(self.ladder.correction_m(planned_m))
 
     def _body_yaw_rad(self) -> float:
         """The yaw of the body's own placement (`_body_shift_m`) [rad]."""
-        return self.ladder.yaw_rad if self._body_on_ladder and self.ladder.observed else 0.0
-
-    def _target_shift(self, planned_m: np.ndarray,
-                      estimate: LadderEstimate | None = None) -> np.ndarray:
-        """A limb's correction towards a hold planned at ``planned_m``, relative to the
-        body (`_ladder_shift` less `_body_shift_m`) [m]: zero below `MIN_CORRECTION_M`,
-        bounded above."""
-        estimate = self.ladder if estimate is None else estimate
-        if not estimate.observed:
-            return np.zeros(3)
-        shift = self._bounded(estimate.correction_m(planned_m) - self._body_shift_m(planned_m))
-        return shift if float(np.linalg.norm(shift)) >= MIN_CORRECTION_M else np.zeros(3)
+        return self.ladder.yaw_rad if self._body_on_ladder else 0.0
 
     def _bounded(self, shift_m: np.ndarray) -> np.ndarray:
         length = float(np.linalg.norm(shift_m))
@@ -401,25 +387,22 @@ class MotionLayer:
         return (self._bounded(R_wp @ (T_held[:3, 3] - T_plan[:3, 3]))
                 + self._body_shift_m(planned_m),
                 R_wp @ Rotation.from_rotvec(turn).as_matrix() @ R_wp.T
-                @ _yaw_matrix(self._body_yaw_rad()))
+                @ rot_z(self._body_yaw_rad()))
 
     def _follow_holds(self, seg: Segment) -> None:
         """Keep every holding limb's correction where it holds at this segment's poses.
 
         A correction is a displacement of the hold in the world (`_correction_at`): taken
         from the limb's references when it starts to hold, it is realised, less the
-        body's own placement
-        (`_body_shift_m`), by inverse kinematics at the segment's last pose and blended
-        in over the segment. A joint offset solved at one pose and kept moves the end
-        frame elsewhere at another: the body rises 30 cm past a held hand, and a foot
-        turned for the ladder's yaw was pulled against its rung by both stiff legs. Once
-        the last foot leaves the floor, the body takes the ladder's placement and the
-        holds on the ladder need no correction of their own."""
+        body's own placement (`_body_shift_m`), by inverse kinematics at the segment's
+        last pose and blended in over the segment. A joint offset solved at one pose and
+        kept moves the end frame elsewhere at another: the body rises 30 cm past a held
+        hand, and a foot turned for the ladder's yaw was pulled against its rung by both
+        stiff legs. Once the last foot leaves the floor, the body takes the ladder's
+        placement and the holds on the ladder need no correction of their own."""
         for limb in seg.moving_limbs:
             self._hold_corrections.pop(limb, None)
         for limb, hold in seg.holds.items():
-            if limb in seg.moving_limbs:
-                continue
             planned_m = np.asarray(hold.position_m)
             if limb not in self._hold_corrections:
                 if limb not in self._offsets:
@@ -429,13 +412,14 @@ class MotionLayer:
             shift_world_m, turn_world = self._hold_corrections[limb]
             dq, _residual = self._limb_shift_dq(
                 limb, seg.last_line - 1, shift_world_m - self._body_shift_m(planned_m),
-                turn_world @ _yaw_matrix(self._body_yaw_rad()).T)
+                turn_world @ rot_z(self._body_yaw_rad()).T)
             self._offsets[limb] = _Blend(self._offset(limb), dq, float(seg.first_line - 1),
                                          float(seg.last_line - 1))
 
     def _enter_segment(self, k: int) -> None:
-        """Measure the held rails again; re-target the reaches of segment ``k`` from the
-        ladder estimate."""
+        """Measure the held rails again; keep the holding limbs where they hold (the body
+        on the ladder's placement once no foot stands on the floor); re-target the
+        reaches of segment ``k`` from the ladder estimate."""
         seg = self.sidecar.segments[k]
         self._observe_held_rails(seg)
         self._body_on_ladder = not any(limb.endswith("_foot") and h.target == "floor"
@@ -444,7 +428,7 @@ class MotionLayer:
         for limb, (_j, hold) in self._next_hold[k].items():
             if seg.phase != "limb" or not self._on_ladder(hold.target):
                 continue
-            shift = self._target_shift(np.asarray(hold.position_m))
+            shift = self._ladder_shift(np.asarray(hold.position_m))
             if not shift.any():
                 if limb not in self._offsets:
                     continue
@@ -485,7 +469,7 @@ class MotionLayer:
             return _Regrasp(side, k, rail, planned, "verify", self._now)
         if line_index == seg.first_line - 1 and (k, side) not in self._arrived:
             limb = f"{side}_hand"
-            wanted = self._target_shift(planned)
+            wanted = self._ladder_shift(planned)
             if np.linalg.norm(wanted - self._shift_m.get(limb, np.zeros(3))) > SAME_TARGET_M:
                 g = _Regrasp(side, k, rail, planned, "retarget", self._now)
                 self._move_hand(g, wanted, "the ladder estimate moved its target")
@@ -507,7 +491,7 @@ class MotionLayer:
         across the rail (where the palm closed against where it was sent), then a pattern
         around the first. Each within the bound and different from where the hand closed
         last and from the others."""
-        centre = self._target_shift(g.planned_m, self.rails)
+        centre = self._ladder_shift(g.planned_m, self.rails)
         towards_ladder = -self.geometry.rung_line_normal
         step = self.config.search_step_m
         current = self._shift_m.get(f"{g.side}_hand", np.zeros(3))
@@ -540,7 +524,7 @@ class MotionLayer:
         current = self._shift_m.get(limb, np.zeros(3))
         rail_m = self.rails.last_held_m(g.rail)
         if rail_m is None:
-            rail_m = g.planned_m + self._ladder_shift(g.planned_m)
+            rail_m = g.planned_m + self._ladder_shift(g.planned_m, relative_to_body=False)
         miss = self._across_rail(g, self.estimate.palm_m[g.side] - rail_m)
         if float(np.linalg.norm(miss)) <= self.config.aim_tolerance_m:
             return False
