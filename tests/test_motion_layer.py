@@ -513,3 +513,85 @@ def test_a_stiff_arm_that_pushes_on_something_complies_again(reach):
     assert "left" not in layer._stiff_arms
     event = layer.events[-1]
     assert event.kind.value == "stiff reach" and "LSP" in event.cause
+
+
+
+def _layer_with_a_compliant_approach(reach):
+    """A layer on the reach fixture whose arms comply from 20 lines before their grasp
+    (as mixed arms do on a plan's last lines of a reach), its player started and paused;
+    and that first compliant line (0-based)."""
+    from execute.motion.layer import MotionLayer
+    from execute.play.player import PlayerOptions, TrajectoryPlayer
+
+    _path, traj, sc, ladder = reach
+    grasp = next(seg for seg in sc.segments if seg.phase == "grasp")
+    switch = grasp.first_line - 21
+    schedule = {arm: [(1, switch, "position"), (switch + 1, len(traj), "pwm")]
+                for arm in ("left", "right")}
+    player = TrajectoryPlayer(traj, PlayerOptions(rate_hz=int(sc.rate_hz)), schedule,
+                              sc.arm_feedforward)
+    layer = MotionLayer(player, traj, sc, ladder)
+    player.step(0.0, traj[0])
+    player.pause(0.0)  # as `MotionLayer.step` does when a wait is due
+    return layer, switch
+
+
+def _sensed(q_rad, right_wrist_fz_n=0.0):
+    sample = new_sample(STATE_DTYPE)
+    sample["pos"] = q_rad
+    sample["ft"]["fz"][2] = right_wrist_fz_n  # RHFT
+    return SensedState.from_sample(sample)
+
+
+def test_a_stiff_arm_that_lags_waits_in_position_mode_before_it_complies(reach):
+    """Mixed arms comply on the last lines of a reach. An arm still behind its reference
+    there is held in position mode, the player waiting, until it catches up; one that
+    does not within the arrival timeout finishes the reach stiff."""
+    _path, traj, _sc, _ladder = reach
+
+    def layer_at_the_switch():
+        layer, switch = _layer_with_a_compliant_approach(reach)
+        line = switch - 1  # the last stiff line
+        assert set(layer._catch_up_at) == {line}
+        (side, _k), *_ = layer._catch_up_at[line]
+        layer._last_ref = traj[line].copy()
+        return layer, line, side
+
+    layer, line, side = layer_at_the_switch()
+    shoulder = JOINT_INDEX[f"{side[0].upper()}SP"]
+    behind = traj[line].copy()
+    behind[shoulder] -= 0.2
+    assert layer._catch_up_due(line, _sensed(traj[line])) is None  # on its reference
+    layer, line, side = layer_at_the_switch()
+    wait = layer._catch_up_due(line, _sensed(behind))
+    assert wait is not None and wait.phase == "catch_up"
+    layer._regrasp, layer._now = wait, 1.0
+    layer._update_regrasp(_sensed(behind))
+    assert layer._regrasp is wait  # still waiting
+    layer._now = 1.5
+    layer._update_regrasp(_sensed(traj[line]))
+    assert layer._regrasp is None and side not in layer._stiff_arms
+    assert layer.events[-1].kind.value == "arrival wait"
+    assert layer._catch_up_due(line, _sensed(behind)) is None  # once per reach
+    layer, line, side = layer_at_the_switch()
+    layer._regrasp = layer._catch_up_due(line, _sensed(behind))
+    layer._now = layer._regrasp.since_s + layer.config.arrival_timeout_s
+    layer._update_regrasp(_sensed(behind))
+    assert layer._regrasp is None and side in layer._stiff_arms
+    assert layer.events[-1].kind.value == "stiff reach"
+
+
+def test_a_hand_pushed_on_its_compliant_last_stretch_does_not_back_off(reach):
+    """A push along the forearm is a strike while the arm moves stiff through the air;
+    on the compliant last stretch of the reach it is the hand meeting its rail."""
+    from execute.motion.estimator import BodyEstimate
+
+    _path, traj, _sc, _ladder = reach
+    layer, switch = _layer_with_a_compliant_approach(reach)
+    layer.estimate = BodyEstimate(0.0, np.eye(4), np.eye(3), {"left": True, "right": True},
+                                  {}, {}, {"left": 0.0, "right": 0.0})
+    push = layer.config.hand_strike_load_n + 5.0
+    assert layer._strike_due(switch + 5, _sensed(traj[switch + 5], push)) is None
+    strike = layer._strike_due(switch - 20, _sensed(traj[switch - 20], push))
+    assert strike is not None and strike.limb == "right_hand"
+    assert layer.events[-1].kind.value == "hand strike"

@@ -5,6 +5,11 @@ hubo-motion-rt and the thesis's operator did (thesis §4.3.4, §6.2):
 
 - **gravity compensation** of the compliant arms (`execute.motion.gravity_compensation`),
   which run with their PWM clamps at the safety ceiling (`execute.motion.gains`);
+- **catching up before complying**: a mixed arm moves stiff through the air and complies
+  on the last lines of its reach; if its palm still lags its reference by more than
+  ``arrival_tolerance_m`` on the last stiff line, the player waits there, the arm in
+  position mode, at most ``arrival_timeout_s``; an arm still behind finishes the reach
+  stiff;
 - **arrival**: before a hand closes, the player waits until the encoders put its palm
   within ``arrival_tolerance_m`` of where its reference does (a PWM arm lags its
   reference), at most ``arrival_timeout_s``. An arm still short of it, if its schedule
@@ -37,7 +42,8 @@ hubo-motion-rt and the thesis's operator did (thesis §4.3.4, §6.2):
   layer **stops** as for a grasp. A reaching hand that its wrist F/T shows pushed by the
   ladder along the forearm (its palm plate on the rail it leaves, the body nearer the
   ladder than planned) backs off along the push the same way, and lets the back-off go
-  over the rest of its reach; its grasp is verified at the end as every grasp is;
+  over the rest of its reach; its grasp is verified at the end as every grasp is. On the
+  compliant last stretch of a reach a push is the hand meeting its rail, not a strike;
 - **a guard on stiff arms**: a stiff arm that pushes near a torque limit complies again;
 - **wrist-roll relief** of a gripping arm (`execute.motion.wrist_relief`), from its motor
   current, while its fingers hold the rail;
@@ -153,7 +159,7 @@ class _Regrasp:
     segment: int
     rail: str
     planned_m: np.ndarray
-    phase: str  # "retarget", "arrive", "verify", "open", "shift", "close"
+    phase: str  # "catch_up", "retarget", "arrive", "verify", "open", "shift", "close"
     since_s: float
     tries: int = 0
     candidates: list = dataclasses.field(default_factory=list)  # re-reach shifts [m]
@@ -239,6 +245,15 @@ class MotionLayer:
         #: placement (`_body_shift_m`)
         self._body_on_ladder = False
         self._arrived: set[tuple[int, str]] = set()
+        #: side → (first compliant line, grasp's first line, grasp segment) of each reach
+        #: whose arm the schedule turns compliant in the air before its grasp, 0-based
+        self._final_approaches = self._compliant_final_approaches()
+        #: the last stiff line of each of those (0-based) → (side, grasp segment)
+        self._catch_up_at: dict[int, list[tuple[str, int]]] = {}
+        for side, approaches in self._final_approaches.items():
+            for start, _first, k in approaches:
+                self._catch_up_at.setdefault(start - 1, []).append((side, k))
+        self._caught_up: set[tuple[int, str]] = set()
         self._last_ref = np.asarray(trajectory_rad[0], dtype=float).copy()
         self._regrasp: _Regrasp | None = None
         self._landing: _Landing | None = None
@@ -273,6 +288,36 @@ class MotionLayer:
                         break
             out.append(targets)
         return out
+
+    def _compliant_final_approaches(self) -> dict[str, list[tuple[int, int, int]]]:
+        """Per arm, the reaches the schedule moves stiff through the air and finishes
+        compliant before their grasp begins (mixed arms comply on the last lines of a
+        reach): (first compliant line, the grasp's first line, the grasp's segment),
+        lines 0-based."""
+        out: dict[str, list[tuple[int, int, int]]] = {side: [] for side in SIDES}
+        for k, seg in enumerate(self.sidecar.segments):
+            if seg.phase != "grasp":
+                continue
+            for limb, (_j, hold) in self._next_hold[k].items():
+                if not (limb.endswith("_hand") and hold.target.startswith("rail")):
+                    continue
+                side = _side(limb)
+                pwm = self.player.schedule.pwm_by_line[side]
+                first = seg.first_line - 1
+                if not pwm[first]:
+                    continue
+                start = first
+                while start > 0 and pwm[start - 1]:
+                    start -= 1
+                if 0 < start < first:
+                    out[side].append((start, first, k))
+        return out
+
+    def _in_final_approach(self, side: str, line_index: int) -> bool:
+        """Whether ``side``'s arm is on the compliant last stretch of a reach at
+        ``line_index`` (`_compliant_final_approaches`)."""
+        return any(start <= line_index < first
+                   for start, first, _k in self._final_approaches[side])
 
     def _on_ladder(self, target: str) -> bool:
         return target != "floor"
@@ -477,6 +522,24 @@ class MotionLayer:
             return _Regrasp(side, k, rail, planned, "arrive", self._now)
         return None
 
+    def _catch_up_due(self, line_index: int, s: SensedState) -> _Regrasp | None:
+        """A stiff reaching arm whose schedule turns it compliant after this line while
+        its palm still lags its reference by more than ``arrival_tolerance_m``: the
+        player waits in position mode for it (a compliant arm switched on far from its
+        reference is flung by its PWM error; on DRC seed 6 under a 3 cm, 1° placement
+        error, a right arm 0.18 rad behind in shoulder pitch struck its rail and never
+        reached it, 2026-11-29)."""
+        for side, k in self._catch_up_at.get(line_index, ()):
+            if (k, side) in self._caught_up or side in self._stiff_arms:
+                continue
+            self._caught_up.add((k, side))
+            if self._palm_lag_m(side, s) <= self.config.arrival_tolerance_m:
+                continue
+            _j, hold = self._next_hold[k][f"{side}_hand"]
+            return _Regrasp(side, k, hold.target, np.asarray(hold.position_m), "catch_up",
+                            self._now)
+        return None
+
     def _palm_lag_m(self, side: str, s: SensedState) -> float:
         """How far the sensed palm stands from where its reference puts it, in the pelvis
         frame (no pose estimate involved) [m]."""
@@ -568,6 +631,23 @@ class MotionLayer:
                 self._settle_offset(limb)
                 self._regrasp = None
                 self.player.resume(now)
+        elif g.phase == "catch_up":
+            lag = self._palm_lag_m(g.side, s)
+            if lag <= cfg.arrival_tolerance_m:
+                self._event(MotionEventKind.ARRIVAL_WAIT, limb, lag,
+                            f"waited {elapsed:.2f} s in position mode for the palm to reach "
+                            f"its reference before the arm complies ({lag * 100:.1f} cm off "
+                            "at the end)")
+            elif elapsed >= cfg.arrival_timeout_s:
+                self._stiff_arms.add(g.side)
+                self._event(MotionEventKind.STIFF_REACH, limb, lag,
+                            f"the arm stayed {lag * 100:.1f} cm behind its reference for "
+                            f"{elapsed:.2f} s in position mode: it finishes the reach in "
+                            "position mode until the grasp is verified")
+            else:
+                return
+            self._regrasp = None
+            self.player.resume(now)
         elif g.phase == "arrive":
             lag = self._palm_lag_m(g.side, s)
             if lag > cfg.arrival_tolerance_m and elapsed >= cfg.arrival_timeout_s \
@@ -792,7 +872,11 @@ class MotionLayer:
                 kind = MotionEventKind.FOOT_STRIKE
             else:
                 load = float(s.hand_wrench(side)[2])
-                if load < cfg.hand_strike_load_n:
+                if load < cfg.hand_strike_load_n or self._in_final_approach(side, line_index):
+                    # on its compliant last stretch the hand meets the rail it goes to:
+                    # its arm gives way, and the arrival and aim place it (backed off
+                    # there, DRC seeds 6 and 11 under a 3 cm, 1–3° placement error lost
+                    # their rail by 7–8 cm, 2026-11-29)
                     continue
                 # the ladder pushes the hand towards the wrist: it gives way along the push
                 frame = self.model.chains[limb].frame
@@ -878,7 +962,7 @@ class MotionLayer:
             self._enter_segment(k)
         if self._regrasp is None and self._landing is None and self._strike is None \
                 and self.stop is None and not tick.going_to_init:
-            due = self._grasp_due(tick.line_index)
+            due = self._catch_up_due(tick.line_index, s) or self._grasp_due(tick.line_index)
             if due is not None:
                 self._regrasp = due
                 self.player.pause(now_s)
