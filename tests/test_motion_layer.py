@@ -595,3 +595,33 @@ def test_a_hand_pushed_on_its_compliant_last_stretch_does_not_back_off(reach):
     strike = layer._strike_due(switch - 20, _sensed(traj[switch - 20], push))
     assert strike is not None and strike.limb == "right_hand"
     assert layer.events[-1].kind.value == "hand strike"
+
+
+def test_a_missed_first_grasp_searches_every_direction_across_the_rail(reach):
+    """With nothing known of the ladder, the re-reaches of a first grasp that closed on
+    nothing where it was sent cover, within the latch's reach of the rail axis, every
+    offset up to a search step towards or away from the ladder and sideways, diagonals
+    included."""
+    from daemon.sim.grasp_latch import GripConfig
+    from execute.motion.estimator import BodyEstimate
+    from execute.motion.layer import MotionLayer, _Regrasp
+    from execute.play.player import PlayerOptions, TrajectoryPlayer
+
+    _path, traj, sc, ladder = reach
+    layer = MotionLayer(TrajectoryPlayer(traj, PlayerOptions(rate_hz=int(sc.rate_hz))),
+                        traj, sc, ladder)
+    k = next(k for k, seg in enumerate(sc.segments) if seg.phase == "grasp")
+    planned = np.asarray(sc.segments[k + 1].holds["left_hand"].position_m)
+    layer.estimate = BodyEstimate(0.0, np.eye(4), np.eye(3), {"left": True, "right": True},
+                                  {"left": planned, "right": planned}, {},
+                                  {"left": 1.57, "right": 1.57})
+    g = _Regrasp("left", k, "rail_left", planned, "verify", 0.0)
+    tries = layer._candidates(g)[:layer.config.grasp_retries]
+    reached = [np.zeros(3)] + tries  # where it closed first, then each re-reach
+    step = layer.config.search_step_m
+    towards, lateral = -layer.geometry.rung_line_normal, layer.geometry.lateral_direction
+    for a in np.linspace(-step, step, 9):
+        for b in np.linspace(-step, step, 9):
+            rail = layer._across_rail(g, a * towards + b * lateral)
+            nearest = min(np.linalg.norm(layer._across_rail(g, t - rail)) for t in reached)
+            assert nearest <= GripConfig().position_tolerance_m, (a, b, nearest)

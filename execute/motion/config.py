@@ -117,7 +117,7 @@ class MotionConfig:
     holding_arm_stiffness: float = 1.0
     max_reach_correction_m: float = 0.06
     max_reach_correction_rad: float = math.radians(15.0)
-    grasp_retries: int = 4
+    grasp_retries: int = 8
     search_step_m: float = 0.025
     open_s: float = 0.8
     shift_s: float = 1.5

@@ -23,6 +23,7 @@ import os
 import sys
 from pathlib import Path
 
+from execute.motion.config import MotionConfig
 from robot.errors import InputError, run_cli
 from robot.vocabulary import FailureCause
 
@@ -45,15 +46,17 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--open-loop", action="store_true",
                    help="play the file as hubo-read-trajectory did, without the motion layer "
                         "(default: closed loop on the sensed state)")
-    p.add_argument("--max-reach-correction", type=float, default=0.06, metavar="M",
-                   help="closed loop: largest shift of a hold target [m], within [0, 0.10] "
-                        "(default 0.06)")
-    p.add_argument("--grasp-retries", type=int, default=4, metavar="N",
+    cfg = MotionConfig()
+    p.add_argument("--max-reach-correction", type=float, default=cfg.max_reach_correction_m,
+                   metavar="M", help="closed loop: largest shift of a hold target [m], within "
+                                     f"[0, 0.10] (default {cfg.max_reach_correction_m})")
+    p.add_argument("--grasp-retries", type=int, default=cfg.grasp_retries, metavar="N",
                    help="closed loop: re-reaches of a hand that closed on nothing, within "
-                        "[0, 8] (default 4)")
-    p.add_argument("--holding-arm-stiffness", type=float, default=1.0, metavar="S",
-                   help="closed loop: share of the PWM stiffness pulling a gripping arm "
-                        "towards the plan, within [0, 1] (default 1)")
+                        f"[0, 8] (default {cfg.grasp_retries})")
+    p.add_argument("--holding-arm-stiffness", type=float, default=cfg.holding_arm_stiffness,
+                   metavar="S", help="closed loop: share of the PWM stiffness pulling a "
+                                     "gripping arm towards the plan, within [0, 1] (default "
+                                     f"{cfg.holding_arm_stiffness})")
     p.add_argument("--json", metavar="R.json", help="write the result here")
     p.add_argument("--video", metavar="V.mp4", help="write an MP4 (needs EGL)")
     p.add_argument("--plots", metavar="DIR", help="write tracking plots and a snapshot strip")
@@ -78,8 +81,6 @@ def ladder_from_sidecar(d: dict, where: str):
 
 def motion_config(args: argparse.Namespace):
     """The motion layer's settings from the flags (refused outside their ranges)."""
-    from execute.motion.config import MotionConfig
-
     return MotionConfig(max_reach_correction_m=args.max_reach_correction,
                         grasp_retries=args.grasp_retries,
                         holding_arm_stiffness=args.holding_arm_stiffness)
