@@ -530,9 +530,9 @@ class MotionLayer:
         """A stiff reaching arm whose schedule turns it compliant after this line while
         its palm still lags its reference by more than ``arrival_tolerance_m``: the
         player waits in position mode for it (a compliant arm switched on far from its
-        reference is flung by its PWM error; on DRC seed 6 under a 3 cm, 1° placement
-        error, a right arm 0.18 rad behind in shoulder pitch struck its rail and never
-        reached it, 2026-11-29)."""
+        reference is flung by its PWM error; on DRC seed 6 under a 0.9, 1.3 cm, 1°
+        placement error, a right arm 0.18 rad behind in shoulder pitch struck its rail,
+        2026-11-29)."""
         for side, k in self._catch_up_at.get(line_index, ()):
             if (k, side) in self._caught_up or side in self._stiff_arms:
                 continue
@@ -879,8 +879,8 @@ class MotionLayer:
                 if load < cfg.hand_strike_load_n or self._in_final_approach(side, line_index):
                     # on its compliant last stretch the hand meets the rail it goes to:
                     # its arm gives way, and the arrival and aim place it (backed off
-                    # there, DRC seeds 6 and 11 under a 3 cm, 1–3° placement error lost
-                    # their rail by 7–8 cm, 2026-11-29)
+                    # there, DRC seed 6's right hand under a 0.9, 1.3 cm, 1° placement
+                    # error ended 8 cm from its rail and never held it, 2026-11-29)
                     continue
                 # the ladder pushes the hand towards the wrist: it gives way along the push
                 frame = self.model.chains[limb].frame
