@@ -299,6 +299,9 @@ class MotionLayer:
         reach): (first compliant line, the grasp's first line, the grasp's segment),
         lines 0-based."""
         out: dict[str, list[tuple[int, int, int]]] = {side: [] for side in SIDES}
+        # the first line of every PWM run, per arm
+        run_starts = {side: np.flatnonzero(np.diff(pwm.astype(np.int8), prepend=0) == 1)
+                      for side, pwm in self.player.schedule.pwm_by_line.items()}
         for k, seg in enumerate(self.sidecar.segments):
             if seg.phase != "grasp":
                 continue
@@ -306,13 +309,11 @@ class MotionLayer:
                 if not (limb.endswith("_hand") and hold.target.startswith("rail")):
                     continue
                 side = _side(limb)
-                pwm = self.player.schedule.pwm_by_line[side]
                 first = seg.first_line - 1
-                if not pwm[first]:
+                if not self.player.schedule.pwm_by_line[side][first]:
                     continue
-                start = first
-                while start > 0 and pwm[start - 1]:
-                    start -= 1
+                starts = run_starts[side]
+                start = int(starts[np.searchsorted(starts, first, side="right") - 1])
                 if 0 < start < first:
                     out[side].append((start, first, k))
         return out
@@ -643,11 +644,10 @@ class MotionLayer:
                             f"its reference before the arm complies ({lag * 100:.1f} cm off "
                             "at the end)")
             elif elapsed >= cfg.arrival_timeout_s:
-                self._stiff_arms.add(g.side)
-                self._event(MotionEventKind.STIFF_REACH, limb, lag,
-                            f"the arm stayed {lag * 100:.1f} cm behind its reference for "
-                            f"{elapsed:.2f} s in position mode: it finishes the reach in "
-                            "position mode until the grasp is verified")
+                self._stiffen(g.side, lag,
+                              f"the arm stayed {lag * 100:.1f} cm behind its reference for "
+                              f"{elapsed:.2f} s in position mode: it finishes the reach in "
+                              "position mode until the grasp is verified")
             else:
                 return
             self._regrasp = None
@@ -659,11 +659,10 @@ class MotionLayer:
                     and self._stiff_in_air(g):
                 # the compliant arm cannot carry itself to the hold: it finishes the reach
                 # in position mode, as it moved in the air, until its grasp is verified
-                self._stiff_arms.add(g.side)
-                self._event(MotionEventKind.STIFF_REACH, limb, lag,
-                            f"the compliant arm stayed {lag * 100:.1f} cm from its reference "
-                            f"for {elapsed:.2f} s: it finishes the reach in position mode "
-                            "until the grasp is verified")
+                self._stiffen(g.side, lag,
+                              f"the compliant arm stayed {lag * 100:.1f} cm from its reference "
+                              f"for {elapsed:.2f} s: it finishes the reach in position mode "
+                              "until the grasp is verified")
                 g.since_s = now
                 return
             if lag <= cfg.arrival_tolerance_m or elapsed >= cfg.arrival_timeout_s:
@@ -703,10 +702,8 @@ class MotionLayer:
                 # a hand that closed on nothing is in the air: a mixed arm re-reaches in
                 # position mode, as it moved through the air, until its grasp is verified
                 # (compliant, an open hand sagged 3–4 cm below each new target on ship)
-                self._stiff_arms.add(g.side)
-                self._event(MotionEventKind.STIFF_REACH, limb, 0.0,
-                            "closed on nothing: the arm re-reaches in position mode until "
-                            "the grasp is verified")
+                self._stiffen(g.side, 0.0, "closed on nothing: the arm re-reaches in position "
+                                           "mode until the grasp is verified")
             g.tries += 1
             g.phase, g.since_s = "open", now
             self._open_fingers.add(g.side)
@@ -717,6 +714,12 @@ class MotionLayer:
         elif g.phase == "shift" and elapsed >= cfg.shift_s:
             self._open_fingers.discard(g.side)
             g.phase, g.since_s = "close", now
+
+    def _stiffen(self, side: str, size_m: float, cause: str) -> None:
+        """Hold ``side``'s arm in position mode until its grasp is verified, as the mixed
+        strategy moves an arm through the air (`_stiff_arms`)."""
+        self._stiff_arms.add(side)
+        self._event(MotionEventKind.STIFF_REACH, f"{side}_hand", size_m, cause)
 
     def _guard_stiff_arms(self, torque_nm: np.ndarray, dt: float) -> None:
         """A stiff arm one of whose joints has pushed past `STIFF_ARM_YIELD` of its limit
