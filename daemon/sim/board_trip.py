@@ -129,6 +129,9 @@ class BoardTripMonitor:
         mag = np.abs(torque_nm)
         np.maximum(self.peak_torque_nm, mag, out=self.peak_torque_nm)
         over = (mag >= self._overload_nm) & self._watched & ~self.tripped
+        if not over.any():  # the common step: nothing near its limit
+            self.overload_s.fill(0.0)
+            return []
         self.overload_s = np.where(over, self.overload_s + dt_s, 0.0)
         new: list[TripEvent] = []
         for j in np.flatnonzero(self.overload_s >= self._trip_s):

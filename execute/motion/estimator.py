@@ -32,6 +32,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+import pinocchio as pin
 
 from execute.motion.config import EstimatorConfig
 from execute.motion.robot_model import MotionRobotModel
@@ -88,14 +89,10 @@ def tilt_from_gravity(up_in_pelvis: np.ndarray) -> np.ndarray:
                      [-s * ky, s * kx, c]])
 
 
-def _rotation(rotvec: np.ndarray) -> np.ndarray:
-    """The rotation matrix of a rotation vector [rad] (Rodrigues; it runs every tick)."""
-    x, y, z = (float(v) for v in rotvec)
-    angle = math.sqrt(x * x + y * y + z * z)
-    if angle < 1e-12:
-        return np.eye(3)
-    K = np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]]) / angle
-    return np.eye(3) + math.sin(angle) * K + (1.0 - math.cos(angle)) * (K @ K)
+def _turn_z(angle_rad: float) -> np.ndarray:
+    """The rotation by ``angle_rad`` about the world's vertical."""
+    c, s = math.cos(angle_rad), math.sin(angle_rad)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
 def _heading_rad(R: np.ndarray) -> float:
@@ -155,16 +152,19 @@ class StateEstimator:
     def _attitude(self, R: np.ndarray, s: SensedState, dt: float) -> np.ndarray:
         """The pelvis attitude after ``dt`` [s]: the gyro's turn (less its learnt
         heading bias), then a step towards the accelerometer's up."""
-        R = _rotation([0.0, 0.0, -self.gyro_bias_rad_s * dt]) @ R \
-            @ _rotation(s.body_angular_rate() * dt)
-        up_seen = self._up / np.linalg.norm(self._up)  # pelvis frame
-        up_now = R[2]  # the world's z seen from the pelvis
-        axis = np.cross(up_seen, up_now)
-        sin_gap = float(np.linalg.norm(axis))
+        R = _turn_z(-self.gyro_bias_rad_s * dt) @ R @ pin.exp3(s.body_angular_rate() * dt)
+        # the axis and angle from the accelerometer's up to the attitude's (pelvis frame),
+        # written out for three-vectors: it runs every tick
+        ux, uy, uz = (float(v) for v in self._up)
+        n = math.sqrt(ux * ux + uy * uy + uz * uz)
+        ux, uy, uz = ux / n, uy / n, uz / n
+        vx, vy, vz = (float(v) for v in R[2])  # the world's z seen from the pelvis
+        axis = np.array([uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx])
+        sin_gap = math.sqrt(float(axis @ axis))
         if sin_gap < 1e-12:
             return R
-        gap = math.atan2(sin_gap, float(up_seen @ up_now))
-        return R @ _rotation(axis * (gap / sin_gap * min(1.0, dt / self.config.level_s)))
+        gap = math.atan2(sin_gap, ux * vx + uy * vy + uz * vz)
+        return R @ pin.exp3(axis * (gap / sin_gap * min(1.0, dt / self.config.level_s)))
 
     def _on_start_floor(self) -> bool:
         """Whether every anchored foot stands on the floor the robot started on."""
@@ -192,7 +192,7 @@ class StateEstimator:
             return R
         gap = float(np.average(gaps, weights=weights))
         self.gyro_bias_rad_s -= gap * dt / cfg.heading_s ** 2
-        return _rotation([0.0, 0.0, 2.0 * gap * min(1.0, dt / cfg.heading_s)]) @ R
+        return _turn_z(2.0 * gap * min(1.0, dt / cfg.heading_s)) @ R
 
     def update(self, s: SensedState) -> BodyEstimate:
         """Fold one sample into the estimate."""
@@ -217,9 +217,13 @@ class StateEstimator:
         R = self._follow_feet(self._attitude(T_wp[:3, :3], s, dt), feet, load, dt)
         T_wp[:3, :3] = R
         if self._anchors:
-            w = np.array([max(load[side], 1e-6) for side in self._anchors])
-            at = [sole_m - R @ feet[side][:3, 3] for side, (sole_m, _h) in self._anchors.items()]
-            T_wp[:3, 3] = np.average(at, axis=0, weights=w)
+            # the anchors' pelvis positions, weighted by their feet's loads
+            at, w = np.zeros(3), 0.0
+            for side, (sole_m, _heading) in self._anchors.items():
+                load_n = max(load[side], 1e-6)
+                at += load_n * (sole_m - R @ feet[side][:3, 3])
+                w += load_n
+            T_wp[:3, 3] = at / w
         self._T_world_pelvis = T_wp
         for side in SIDES:
             if side not in self._anchors and load[side] > cfg.foot_contact_on_n:

@@ -31,6 +31,13 @@ class LimbChain:
     columns: tuple[int, ...]  # file columns of the joints that move it
 
 
+def _memo_key(q_cols_rad: np.ndarray, R_world_pelvis: np.ndarray) -> bytes:
+    """The bytes of a configuration (joints, tilt): the memos compare them at every call,
+    several times a tick, and comparing bytes costs far less than comparing arrays."""
+    return (np.asarray(q_cols_rad, dtype=float).tobytes()
+            + np.asarray(R_world_pelvis, dtype=float).tobytes())
+
+
 class MotionRobotModel:
     """Gravity, kinematics and limb IK of one robot (see the module docstring).
 
@@ -71,9 +78,9 @@ class MotionRobotModel:
         # of their own (the other methods overwrite `self.data` with other configurations):
         # a tick asks several questions of the sensed configuration (`_kinematics_at`).
         self._jac_data = m.createData()
-        self._jac_at: tuple[np.ndarray, np.ndarray] | None = None
-        #: (joints, tilt, torques) of the last two `gravity_torques` configurations
-        self._gravity_memo: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
+        self._jac_at: bytes | None = None  # `_memo_key` of the configuration in it
+        #: (`_memo_key`, torques) of the last two `gravity_torques` configurations
+        self._gravity_memo: list[tuple[bytes, np.ndarray]] = []
 
     # ------------------------------------------------------------------ conversions
     def configuration(self, q_cols_rad: np.ndarray, T_world_pelvis: np.ndarray | None = None
@@ -96,13 +103,12 @@ class MotionRobotModel:
     def _kinematics_at(self, q_cols_rad: np.ndarray, R_world_pelvis: np.ndarray):
         """`_jac_data` with joint Jacobians and frame placements at these joints and tilt,
         computed again only when they differ from the last call's."""
-        last = self._jac_at
-        if last is None or not (np.array_equal(last[0], q_cols_rad)
-                                and np.array_equal(last[1], R_world_pelvis)):
+        key = _memo_key(q_cols_rad, R_world_pelvis)
+        if key != self._jac_at:
             d = self._jac_data
             pin.computeJointJacobians(self.model, d, self._tilted(q_cols_rad, R_world_pelvis))
             pin.updateFramePlacements(self.model, d)
-            self._jac_at = (np.array(q_cols_rad, dtype=float), np.array(R_world_pelvis))
+            self._jac_at = key
         return self._jac_data
 
     # ------------------------------------------------------------------ dynamics
@@ -114,15 +120,15 @@ class MotionRobotModel:
         once (gravity compensation, each gripping hand's wrench) beside the plan's: the
         last two configurations' torques are kept, and a copy is returned.
         """
-        for q, R, g in self._gravity_memo:
-            if np.array_equal(q, q_cols_rad) and np.array_equal(R, R_world_pelvis):
+        key = _memo_key(q_cols_rad, R_world_pelvis)
+        for known, g in self._gravity_memo:
+            if known == key:
                 return g.copy()
         g = pin.computeGeneralizedGravity(self.model, self.data,
                                           self._tilted(q_cols_rad, R_world_pelvis))
         out = np.zeros(len(JOINT_NAMES))
         out[self._have] = g[self._v_cols]
-        self._gravity_memo = [(np.array(q_cols_rad, dtype=float), np.array(R_world_pelvis),
-                               out), *self._gravity_memo[:1]]
+        self._gravity_memo = [(key, out), *self._gravity_memo[:1]]
         return out.copy()
 
     def force_torques(self, q_cols_rad: np.ndarray, R_world_pelvis: np.ndarray, limb: str,
@@ -175,7 +181,10 @@ class MotionRobotModel:
         jacobian = pin.getFrameJacobian(self.model, d, sole, pin.LOCAL_WORLD_ALIGNED)
         column = jacobian[:, self._v_of_col[joint_cols]]
         r = d.oMf[palm].translation - d.oMf[sole].translation
-        return (column[:3] + np.cross(column[3:], r, axis=0)).T
+        a, b = column[:3], column[3:]
+        b_cross_r = np.array([b[1] * r[2] - b[2] * r[1], b[2] * r[0] - b[0] * r[2],
+                              b[0] * r[1] - b[1] * r[0]])  # column by column
+        return (a + b_cross_r).T
 
     def com_m(self, q_cols_rad: np.ndarray, T_world_pelvis: np.ndarray) -> np.ndarray:
         """Whole-body centre of mass in the world [m]."""
