@@ -192,3 +192,28 @@ def test_config_refuses_bad_values():
         BoardModelConfig(battery_v=500.0)
     with pytest.raises(InputError, match="divide"):
         BoardModelConfig(physics_dt_s=0.002)
+
+
+def _yaw_deg(R: np.ndarray) -> float:
+    return float(np.degrees(np.arctan2(R[1, 0], R[0, 0])))
+
+
+def test_reset_stands_the_soles_flat_facing_x_with_the_pelvis_turned_as_the_pose_has_it(board):
+    """A plan for a ladder placed at a yaw starts with the pelvis turned towards it on
+    straight feet (both hip yaws turned). The simulated robot must start in that stance,
+    not with an upright pelvis that turns the feet, and the robot, away from its plan."""
+    q = np.zeros(NUM_JOINTS)
+    q[JOINT_INDEX["LHY"]] = q[JOINT_INDEX["RHY"]] = 0.05  # the pelvis 0.05 rad from the feet
+    soles = {"left": np.array([0.0, 0.0885, 0.0]), "right": np.array([0.0, -0.0885, 0.0])}
+    board.reset(q, soles)
+    d = board.data
+    sole_yaws = [_yaw_deg(d.site(f"{s}_sole").xmat.reshape(3, 3)) for s in "LR"]
+    assert sole_yaws == pytest.approx([0.0, 0.0], abs=1e-6)
+    for s in "LR":
+        assert d.site(f"{s}_sole").xmat.reshape(3, 3)[2, 2] == pytest.approx(1.0, abs=1e-9)
+    R_pelvis = np.zeros(9)
+    mujoco.mju_quat2Mat(R_pelvis, d.qpos[3:7])
+    assert abs(_yaw_deg(R_pelvis.reshape(3, 3))) == pytest.approx(np.degrees(0.05), abs=1e-6)
+    mean = (d.site("L_sole").xpos + d.site("R_sole").xpos) / 2
+    assert mean[:2] == pytest.approx([0.0, 0.0], abs=1e-9)
+    assert min(d.site("L_sole").xpos[2], d.site("R_sole").xpos[2]) == pytest.approx(0.0, abs=1e-9)

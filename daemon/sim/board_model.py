@@ -267,15 +267,25 @@ class BoardModel:
               sole_targets_m: dict[str, np.ndarray] | None = None) -> None:
         """Robot at rest in joint pose ``q_rad`` (40,) (zero pose if None), standing.
 
-        The floating base is upright; it is lowered until the lowest sole touches the
-        floor and, with ``sole_targets_m`` (``"left"``/``"right"`` → sole position [m]),
-        shifted so the soles' mean matches the targets' mean horizontally.
+        The floating base is turned so that the left sole lies flat and faces the world's
+        x axis, as a plan's start stance has its soles (and as the motion layer's
+        estimator assumes): a plan for a ladder placed at a yaw starts with the pelvis
+        turned towards it on straight feet, and an upright base would turn the whole
+        robot away from its plan by that yaw. It is then lowered until the lowest sole
+        touches the floor and, with ``sole_targets_m`` (``"left"``/``"right"`` → sole
+        position [m]), shifted so the soles' mean matches the targets' mean horizontally.
         """
         m, d = self.model, self.data
         mujoco.mj_resetDataKeyframe(m, d, 0)
         q = np.zeros(NUM_JOINTS) if q_rad is None else np.asarray(q_rad, dtype=float)
         d.qpos[self.qpos_adr] = q[self.cols]
         d.qpos[3:7] = (1.0, 0.0, 0.0, 0.0)
+        mujoco.mj_kinematics(m, d)
+        # with the base upright, the sole's orientation is the base's frame to the sole's;
+        # the base's orientation that levels the sole is its transpose
+        base_quat = np.zeros(4)
+        mujoco.mju_mat2Quat(base_quat, d.site("L_sole").xmat.reshape(3, 3).T.flatten())
+        d.qpos[3:7] = base_quat
         mujoco.mj_kinematics(m, d)
         soles = {h: d.site(f"{h[0].upper()}_sole").xpos.copy() for h in ("left", "right")}
         shift = np.zeros(3)
