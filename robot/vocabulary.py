@@ -167,6 +167,7 @@ class FailureCause(StrEnum):
     FINAL_STANCE = "final_stance"
     GRASP_UNVERIFIED = "grasp_unverified"  # the motion layer stopped (`execute.motion`)
     FOOTHOLD_UNVERIFIED = "foothold_unverified"  # it stopped: a foot found no rung
+    LADDER_MISPLACED = "ladder_misplaced"  # it stopped: the hands found the ladder elsewhere
     NO_PLAN = "no_plan"  # batch-eval: the plan job found no plan, nothing was simulated
 
 

@@ -237,3 +237,56 @@ def test_a_stance_that_turns_while_the_hands_reach_is_seen_and_the_hands_aimed(m
         lever = np.linalg.norm(palm[:2])
         assert aims[f"{side}_hand"].size_m == pytest.approx(lever * turn_rad, rel=0.35)
     assert layer.stop is None
+
+
+def test_a_misplaced_ladder_is_measured_by_the_first_grasps_and_planned_for_again(
+        mount, monkeypatch):
+    """The ladder stands 3 cm further, 2 cm to the left and turned 2.3° from the
+    plan's. With ``replan_beyond_m``, the layer stops after the two first grasps, before
+    any weight moves onto the ladder, with the ladder's placement as the hands measured
+    it; the hands open and retrace the plan to its start; the run goes on with the plan
+    for the ladder as measured. The planner's search (minutes on this machine) is
+    replaced here by the same lines played against the measured ladder: what is pinned is
+    the measurement, the retreat and the hand-over, not a new plan's climb (measured by
+    `batch-eval`, docs/results.md)."""
+    import execute.validate.simulate as sim
+    from daemon.sim.board_model import PlacementError
+    from execute.motion.config import MotionConfig
+
+    sc = read_sidecar(sidecar_path(mount))
+    traj = read_trajectory(mount, sc.rate_hz)
+    drc = load_ladder("drc")
+    error = PlacementError(0.03, 0.02, 0.04)
+    measured = {}
+
+    def same_lines_for_the_measured_ladder(robot, sidecar, ladder, motion):
+        measured["stop"] = motion.stop
+        measured["events"] = motion.report()["events"]
+        placed = motion.ladder.placed(ladder, *motion.stance())
+        return (traj, sidecar, placed), {"shift_m": motion.stop.details["shift_m"],
+                                         "yaw_rad": motion.stop.details["yaw_rad"],
+                                         "worst_hold_m": motion.stop.details["worst_hold_m"],
+                                         "planning_s": 0.0, "no_plan": None}
+
+    monkeypatch.setattr(sim, "_replan_after_touch", same_lines_for_the_measured_ladder)
+    run = simulate(traj, sc, drc, SimulationOptions(
+        record_qpos=False, placement=error, motion=MotionConfig(replan_beyond_m=0.02)))
+    stop = measured["stop"]
+    assert stop.cause.value == "ladder_misplaced" and stop.details["worst_hold_m"] > 0.02
+    verified = [e for e in measured["events"] if e["kind"] == "grasp verified"]
+    assert len(verified) == 2 and stop.time_s >= verified[-1]["time_s"]
+    # no foot had left the floor: the stop came in the first step, placeHands
+    assert sc.segment_at(stop.line).primitive == "placeHands"
+    # the new run's misplacement is what the hands could not see: a few millimetres
+    residual = run.options.placement
+    assert np.hypot(residual.dx_m, residual.dy_m) < 0.008
+    assert abs(residual.dyaw_rad) < np.radians(0.5)
+    assert run.ladder.placement_yaw_rad == pytest.approx(0.04, abs=np.radians(0.5))
+    # the stop tells an operator the placement to plan for: the one planned for here
+    assert stop.details["placement"]["yaw_rad"] == pytest.approx(run.ladder.placement_yaw_rad,
+                                                                abs=1e-4)
+    # the second run starts after the retreat, both hands open, and grasps again
+    assert run.log.time_s[0] > stop.time_s + sim.RETRACT_OPEN_S
+    assert not run.log.latched[0].any()
+    assert run.motion["counts"].get("grasp verified", 0) >= 2
+    assert run.replan is not None and run.replan["placement_error_before"]["dx_m"] == 0.03

@@ -171,6 +171,37 @@ def test_the_ladder_estimate_recovers_shift_and_yaw():
     assert est.yaw_rad == pytest.approx(yaw, abs=0.005)
 
 
+def test_the_ladder_placed_as_the_hands_found_it_has_its_rails_through_their_grasps():
+    """Two grasps from the floor on a ladder misplaced by 3 cm, -2 cm and 2.3°: the spec
+    `LadderEstimate.placed` returns (for a new plan) has each rail's axis through the
+    palm that held it, and its placement within a few millimetres and a tenth of a
+    degree of the real one."""
+    from ladders.geometry import LadderGeometry
+
+    planned = load_ladder("drc")
+    real = PlacementError(0.03, -0.02, 0.04).apply(planned)
+    g_plan, g_real = LadderGeometry(planned), LadderGeometry(real)
+    T = g_real.T_world_ladder @ np.linalg.inv(g_plan.T_world_ladder)
+    est = LadderEstimate(max_shift_m=0.1, max_yaw_rad=0.3)
+    for side in ("left", "right"):
+        a, b = g_plan.rail_axis(side)
+        hold = a + 0.35 * (b - a)  # a grasp about a metre up the rail
+        palm = T[:3, :3] @ hold + T[:3, 3]  # where that hold really is
+        est.add(RailObservation(f"rail_{side}", hold, palm, (b - a) / np.linalg.norm(b - a)))
+    placed = est.placed(planned)
+    assert placed.placement_x_m == pytest.approx(real.placement_x_m, abs=0.004)
+    assert placed.placement_y_m == pytest.approx(real.placement_y_m, abs=0.004)
+    assert placed.placement_yaw_rad == pytest.approx(real.placement_yaw_rad, abs=0.002)
+    g_new = LadderGeometry(placed)
+    for side in ("left", "right"):
+        a, b = g_real.rail_axis(side)
+        for p in (a, b):  # the new plan's rail ends lie on the real rails' axes
+            q0, q1 = g_new.rail_axis(side)
+            d = (q1 - q0) / np.linalg.norm(q1 - q0)
+            off = (p - q0) - ((p - q0) @ d) * d
+            assert np.linalg.norm(off) < 0.006
+
+
 def test_observations_on_the_ladder_move_the_shift_not_the_yaw():
     """Hands seen at different times on the ladder, with the body's heading drifting
     between them, must not read as the ladder turning: the floor's yaw is kept."""

@@ -66,6 +66,7 @@ _RANGES = {
     "strike_backoff_s": (0.1, 3.0),
     "strike_tries": (0, 4),
     "hand_strike_load_n": (5.0, 100.0),
+    "replan_beyond_m": (0.0, 0.2),
 }
 
 
@@ -110,6 +111,14 @@ class MotionConfig:
             the forearm is pushed by the ladder (in the air it reads its own weight,
             −3 to −12 N) [N]; it backs off as a foot does (``strike_backoff_m``,
             ``strike_tries``), along the push.
+        replan_beyond_m: when both first grasps, made from the floor, put some hold of
+            the plan further than this from where the ladder really has it, the layer
+            stops before any weight moves onto the ladder (``ladder_misplaced``, with the
+            ladder's measured placement): the plan is for another ladder pose, and bounded
+            corrections of each reach leave the body's posture, and its loads, the
+            plan's for the wrong ladder. ``validate-plan`` then re-plans for the measured
+            placement and climbs that plan; on the robot the operator does. 0: never
+            (each reach is corrected instead) [m].
         estimator: the state estimator's thresholds.
     """
 
@@ -136,6 +145,7 @@ class MotionConfig:
     strike_backoff_s: float = 0.3
     strike_tries: int = 2
     hand_strike_load_n: float = 15.0
+    replan_beyond_m: float = 0.0
     estimator: EstimatorConfig = field(default_factory=EstimatorConfig)
 
     def __post_init__(self) -> None:

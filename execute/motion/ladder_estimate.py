@@ -22,9 +22,13 @@ tell the body's heading from their own lateral settling.
 
 from __future__ import annotations
 
+import dataclasses
+import math
 from dataclasses import dataclass
 
 import numpy as np
+
+from ladders.spec import LadderSpec
 
 __all__ = ["LadderEstimate", "RailObservation"]
 
@@ -66,6 +70,49 @@ class LadderEstimate:
     @property
     def observed(self) -> bool:
         return bool(self._latest)
+
+    @property
+    def rails_fitting_yaw(self) -> int:
+        """How many rails the yaw is fitted on (observed from the floor): 2 once both
+        hands have held theirs."""
+        return len(self._for_yaw)
+
+    def placed(self, spec: LadderSpec, stance_m: np.ndarray | None = None,
+               stance_heading_rad: float = 0.0) -> LadderSpec:
+        """``spec`` with its placement where this estimate finds the ladder: turned by
+        the yaw about the centre of the holds seen, then shifted horizontally (the ladder
+        stands on the floor) by as much as the rails were seen to move across themselves.
+        Along a sloped rail nothing is seen, so the estimate's own shift is the shortest
+        that explains the grasps and lies partly along the rail, out of the floor; the
+        horizontal shift that explains them is found again here.
+
+        Args:
+            spec: the ladder the observations' planned holds were planned on.
+            stance_m, stance_heading_rad: where the robot now stands in the estimate's
+                frame (its soles' middle [m] and heading [rad]): the placement returned
+                is relative to that stance, as a new plan starting there needs it.
+        """
+        rows, seen = [], []
+        for o in self._latest.values():
+            P = np.eye(3) - np.outer(o.rail_direction, o.rail_direction)
+            rows.append(P[:, :2])
+            seen.append(P @ self.shift_m)
+        shift = (np.linalg.lstsq(np.vstack(rows), np.concatenate(seen), rcond=None)[0]
+                 if rows else np.zeros(2))
+        c = self.centre_m[:2]
+        cos, sin = math.cos(self.yaw_rad), math.sin(self.yaw_rad)
+        x, y = spec.placement_x_m - c[0], spec.placement_y_m - c[1]
+        at = np.array([c[0] + cos * x - sin * y + shift[0], c[1] + sin * x + cos * y + shift[1]])
+        yaw = spec.placement_yaw_rad + self.yaw_rad
+        if stance_m is not None:  # the same pose seen from the stance
+            h = stance_heading_rad
+            d = at - np.asarray(stance_m, dtype=float)[:2]
+            at = np.array([math.cos(h) * d[0] + math.sin(h) * d[1],
+                           -math.sin(h) * d[0] + math.cos(h) * d[1]])
+            yaw -= h
+        return dataclasses.replace(spec, placement_x_m=float(at[0]),
+                                   placement_y_m=float(at[1]),
+                                   placement_yaw_rad=math.atan2(math.sin(yaw), math.cos(yaw)))
 
     def last_held_m(self, rail: str) -> np.ndarray | None:
         """Where a hand last held ``rail``: its measured palm in the world [m]; None if

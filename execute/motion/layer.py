@@ -234,6 +234,10 @@ class MotionLayer:
         self.rails = LadderEstimate(self.config.max_reach_correction_m,
                                     self.config.max_reach_correction_rad)
         self._segment_of_line = segment_of_lines(sidecar, "plan")
+        #: every hold the plan puts on the ladder (rungs, rails), world [m]
+        self._ladder_holds_m = np.array(
+            [h.position_m for seg in sidecar.segments for h in seg.holds.values()
+             if self._on_ladder(h.target)]).reshape(-1, 3)
         self._next_hold = self._next_holds(sidecar.segments)
         self._finger_cols = {side: joint_indices(FINGER_JOINTS[side]) for side in SIDES}
         self._arm_cols = {side: joint_indices(ARM_JOINTS[side]) for side in SIDES}
@@ -277,6 +281,24 @@ class MotionLayer:
         self.estimate: BodyEstimate | None = None
         self._line = 0
         self._now = 0.0
+        self._pos_rad = np.asarray(trajectory_rad[0], dtype=float)  # the last sample's encoders
+
+    def stance(self) -> tuple[np.ndarray, float]:
+        """Where the robot stands in the estimate's frame: the middle of its soles [m]
+        and their mean heading [rad], from the last sample's encoders and the body's
+        estimated pose (feet can turn on the floor while the hands search)."""
+        T_wp = self.estimate.T_world_pelvis
+        frames = self.model.frames_in_pelvis(self._pos_rad, ("L_sole", "R_sole"))
+        soles = [T_wp @ T for T in frames.values()]
+        middle = np.mean([T[:3, 3] for T in soles], axis=0)
+        x_axis = np.sum([T[:3, 0] for T in soles], axis=0)  # the soles' mean heading
+        return middle, float(np.arctan2(x_axis[1], x_axis[0]))
+
+    @property
+    def last_reference_rad(self) -> np.ndarray:
+        """The references of the last tick's command [rad] (a copy): the plan's line
+        with the layer's corrections."""
+        return self._last_ref.copy()
 
     # ------------------------------------------------------------------ plan queries
     @staticmethod
@@ -775,7 +797,40 @@ class MotionLayer:
                         f"ladder shifted {np.round(self.ladder.shift_m * 100, 1).tolist()} "
                         f"cm, yawed {np.degrees(self.ladder.yaw_rad):.1f}°")
         self._regrasp = None
+        if on_floor and self._misplaced_ladder():
+            return  # the pose is held: the plan is for a ladder elsewhere
         self.player.resume(self._now)
+
+    def _misplaced_ladder(self) -> bool:
+        """With both rails measured from the floor, stop the climb (``ladder_misplaced``)
+        if the plan's holds lie further than ``replan_beyond_m`` from where the ladder has
+        them (`MotionConfig.replan_beyond_m`): the details give the ladder's measured
+        placement change, for a new plan."""
+        limit_m = self.config.replan_beyond_m
+        if limit_m <= 0.0 or self.ladder.rails_fitting_yaw < 2 or not len(self._ladder_holds_m):
+            return False
+        offsets_m = [float(np.linalg.norm(self.ladder.correction_m(p)[:2]))
+                     for p in self._ladder_holds_m]
+        worst_m = max(offsets_m)
+        if worst_m <= limit_m:
+            return False
+        shift_m, yaw_rad = self.ladder.shift_m, self.ladder.yaw_rad
+        placed = self.ladder.placed(self.geometry.spec, *self.stance())
+        placement = {"x_m": round(placed.placement_x_m, 4), "y_m": round(placed.placement_y_m, 4),
+                     "yaw_rad": round(placed.placement_yaw_rad, 4)}
+        reason = (f"the hands found the ladder shifted {np.round(shift_m[:2] * 100, 1).tolist()} "
+                  f"cm and turned {np.degrees(yaw_rad):.1f}° from where the plan has it: its "
+                  f"holds lie up to {worst_m * 100:.1f} cm from the real ones (re-plan beyond "
+                  f"{limit_m * 100:.1f} cm); the weight was not moved onto the ladder. Plan "
+                  "again with the spec's placement, seen from where the robot stands: "
+                  + ", ".join(f"{k} = {v:g}" for k, v in placement.items()))
+        self.stop = MotionStop(self._now, self._line + 1, "", reason,
+                               FailureCause.LADDER_MISPLACED, 0,
+                               {"shift_m": [round(float(v), 4) for v in shift_m],
+                                "yaw_rad": round(float(yaw_rad), 5),
+                                "worst_hold_m": round(worst_m, 4), "placement": placement})
+        self._event(MotionEventKind.STOP, "", worst_m, reason)
+        return True
 
     def _stop(self, g: _Regrasp, reason: str) -> None:
         self._open_fingers.add(g.side)
@@ -950,6 +1005,7 @@ class MotionLayer:
         """The command of the tick at ``now_s``, from the daemon's state sample."""
         self._now = now_s
         s = SensedState.from_sample(state_sample)
+        self._pos_rad = s.pos_rad
         self.estimate = self.estimator.update(s)
         dt = 0.0 if self._last_now is None else now_s - self._last_now
         self._last_now = now_s

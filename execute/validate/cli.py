@@ -19,6 +19,7 @@ from __future__ import annotations
 import argparse
 import json
 import logging
+import math
 import os
 import sys
 from pathlib import Path
@@ -57,6 +58,11 @@ def _parser() -> argparse.ArgumentParser:
                    metavar="S", help="closed loop: share of the PWM stiffness pulling a "
                                      "gripping arm towards the plan, within [0, 1] (default "
                                      f"{cfg.holding_arm_stiffness})")
+    p.add_argument("--replan-beyond", type=float, default=cfg.replan_beyond_m, metavar="M",
+                   help="closed loop: when the first two grasps find the plan's holds further "
+                        "than M from the real ones, open the hands, retrace the plan, plan "
+                        "again for the ladder where the hands found it and climb that plan; "
+                        f"within [0, 0.2], 0 never (default {cfg.replan_beyond_m:g})")
     p.add_argument("--json", metavar="R.json", help="write the result here")
     p.add_argument("--video", metavar="V.mp4", help="write an MP4 (needs EGL)")
     p.add_argument("--plots", metavar="DIR", help="write tracking plots and a snapshot strip")
@@ -83,7 +89,8 @@ def motion_config(args: argparse.Namespace):
     """The motion layer's settings from the flags (refused outside their ranges)."""
     return MotionConfig(max_reach_correction_m=args.max_reach_correction,
                         grasp_retries=args.grasp_retries,
-                        holding_arm_stiffness=args.holding_arm_stiffness)
+                        holding_arm_stiffness=args.holding_arm_stiffness,
+                        replan_beyond_m=args.replan_beyond)
 
 
 def motion_summary(report: dict) -> str:
@@ -115,6 +122,10 @@ NEXT_STEP = {
                                    "why); --open-loop plays the file as the thesis did",
     FailureCause.FOOTHOLD_UNVERIFIED: "a foot found no rung where the plan put it: check the "
                                       "ladder's rung heights against its spec",
+    FailureCause.LADDER_MISPLACED: "the ladder stands elsewhere than the plan's: set the "
+                                   "spec's placement to the one in the JSON's motion stop "
+                                   "details and plan again (validate-plan --replan-beyond "
+                                   "does this itself)",
 }
 #: The longest cause line printed; the full text is the JSON's ``why``.
 CAUSE_CHARS = 160
@@ -189,7 +200,21 @@ def result_json(run, metrics, plan_path: str, comparison=None) -> dict:
         "metrics": metrics.to_json(),
         "plan_vs_sim": None if comparison is None else comparison.to_json(),
         "motion": run.motion,
+        "replan": run.replan,
     }
+
+
+def replan_summary(replan: dict) -> str:
+    """One line on a re-plan after the first touch."""
+    shift = [round(v * 100, 1) for v in replan["shift_m"][:2]]
+    found = (f"the hands found the ladder shifted {shift} cm and turned "
+             f"{math.degrees(replan['yaw_rad']):.1f}° (holds up to "
+             f"{replan['worst_hold_m'] * 100:.1f} cm off)")
+    if replan.get("no_plan"):
+        return (f"re-planning after the first touch: {found}; the planner found no plan for "
+                f"it in {replan['planning_s']:.0f} s: {replan['no_plan']}")
+    return (f"re-planned after the first touch: {found}; planned again in "
+            f"{replan['planning_s']:.0f} s; the run below is that plan's")
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -229,6 +254,9 @@ def _run(args: argparse.Namespace) -> int:
                           show=lambda done, total: f"{done:.1f}/{total:.1f}") as progress:
         run = simulate(traj, sidecar, ladder, opts, robot,
                        progress=lambda sim_s, total_s: progress.update(sim_s, total=total_s))
+    if run.replan is not None:  # the run climbed a new plan, for the ladder as measured
+        traj, sidecar, ladder = run.trajectory_rad, run.sidecar, run.ladder
+        print(replan_summary(run.replan), flush=True)
     metrics = compute_metrics(run)
     verifier = plan_verifier(sidecar, ladder, robot)  # one for every comparison below
     comparison = compare_with_plan(run, traj, ladder, verifier)

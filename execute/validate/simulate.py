@@ -20,10 +20,19 @@ position mode):
 
 The robot starts at rest in the pose of line 1, soles on the floor where the plan's
 first segment puts them.
+
+**Re-planning after the first touch** (closed loop, `MotionConfig.replan_beyond_m`): when
+the motion layer stops because its first two grasps, made from the floor, found the
+ladder where the plan's holds are too far from the real ones, the run does what an
+operator would: the hands open and retrace the plan back to its first line, the planner
+plans again (same seed, same top rung) for the ladder where the hands found it, and the
+new plan is climbed from there, the same physics going on. The run's log and verdict are
+the new plan's; `SimulationRun.replan` tells what was measured and how long planning took.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import math
 import time
@@ -46,7 +55,7 @@ from ladders.geometry import LadderGeometry
 from ladders.spec import LadderSpec
 from robot.errors import InputError
 from robot.plan_sidecar import PlanSidecar
-from robot.vocabulary import ArmStrategy, HoldTargetKind, Limb
+from robot.vocabulary import ArmStrategy, FailureCause, HoldTargetKind, Limb
 
 __all__ = ["STRATEGIES", "SimulationLog", "SimulationOptions", "SimulationRun", "simulate"]
 
@@ -121,6 +130,14 @@ class SimulationRun:
     simulated_s: float
     rate_hz: float
     motion: dict | None = None  # what the motion layer did (`MotionLayer.report`)
+    #: the re-plan after the first touch, when there was one (module docstring):
+    #: measured shift [m] and yaw [rad], the new placement, planning wall time [s],
+    #: the misplacement before it, and the first plan's motion report. ``sidecar``,
+    #: ``trajectory_rad``, ``ladder`` and ``options.placement`` are then the new plan's
+    #: (its ladder as measured, and the real ladder's misplacement from it).
+    replan: dict | None = None
+    trajectory_rad: np.ndarray | None = None  # the plan played (the lines of ``log``)
+    ladder: LadderSpec | None = None  # the ladder that plan was made for
 
     @property
     def real_time_factor(self) -> float:
@@ -223,11 +240,138 @@ def simulate(trajectory_rad: np.ndarray, sidecar: PlanSidecar, ladder: LadderSpe
     wall0 = time.perf_counter()
     failure, line_index = _run_ticks(board, player, motion, controller, monitor, gains, rec,
                                      opt, progress)
+    replan = None
+    if failure is None and motion is not None and motion.stop is not None \
+            and motion.stop.cause is FailureCause.LADDER_MISPLACED:
+        real_ladder = opt.placement.apply(ladder)
+        failure, line_index = _retract(board, controller, gains, opt, trajectory_rad,
+                                       sidecar, line_index, motion.last_reference_rad)
+        new_plan = None
+        if failure is None:
+            new_plan, replan = _replan_after_touch(robot, sidecar, ladder, motion)
+        if new_plan is not None:
+            trajectory_rad, sidecar, ladder = new_plan
+            replan["placement_error_before"] = dataclasses.asdict(opt.placement)
+            yaw = real_ladder.placement_yaw_rad - ladder.placement_yaw_rad
+            opt = dataclasses.replace(opt, placement=PlacementError(
+                real_ladder.placement_x_m - ladder.placement_x_m,
+                real_ladder.placement_y_m - ladder.placement_y_m,
+                math.atan2(math.sin(yaw), math.cos(yaw))))
+            schedule, compliant = _schedule(opt.strategy, sidecar, len(trajectory_rad))
+            player = TrajectoryPlayer(trajectory_rad,
+                                      PlayerOptions(rate_hz=rate, compliant_arms=compliant,
+                                                    go_to_init=True),
+                                      schedule, sidecar.arm_feedforward)
+            # one re-plan: the new plan's own small misplacement is corrected reach by reach
+            motion = MotionLayer(player, trajectory_rad, sidecar, ladder, robot,
+                                 dataclasses.replace(opt.motion or MotionConfig(),
+                                                     replan_beyond_m=0.0))
+            T_err = LadderGeometry(opt.placement.apply(ladder)).T_world_ladder @ np.linalg.inv(
+                LadderGeometry(ladder).T_world_ladder)
+            monitor = VerdictMonitor(board, sidecar, T_err, opt.verdict)
+            rec = _Recorder(int(math.ceil((player.duration_s + opt.verdict.settle_s)
+                                          / TICK_S)),
+                            board.model.nq if opt.record_qpos else 0)
+            failure, line_index = _run_ticks(board, player, motion, controller, monitor,
+                                             gains, rec, opt, progress, t0_s=board.time_s)
     wall = time.perf_counter() - wall0
     sim_log = rec.log()
     verdict = _final_verdict(failure, motion, monitor, board.time_s, line_index)
     return SimulationRun(verdict, sim_log, board, sidecar, opt, wall, board.time_s, rate,
-                         None if motion is None else motion.report())
+                         None if motion is None else motion.report(), replan,
+                         trajectory_rad, ladder)
+
+
+#: How long the hands take to open before they retrace the plan, after the first touch [s].
+RETRACT_OPEN_S = 1.0
+
+
+def _retract(board: BoardModel, controller: JointController, gains: PwmGains,
+             opt: SimulationOptions, trajectory_rad: np.ndarray, sidecar: PlanSidecar,
+             line_index: int, held_ref_rad: np.ndarray) -> tuple[Failure | None, int]:
+    """After a ``ladder_misplaced`` stop: the hands open where they hold
+    (``held_ref_rad``, the motion layer's last reference, its corrections included),
+    their corrections fade out, and they retrace the plan from line ``line_index`` back
+    to its first, in position mode, the weight still on the floor (module docstring).
+
+    Returns:
+        A failure on the way (None if none) and the line index it ended on (0).
+    """
+    from robot.joints import FINGER_JOINTS, joint_indices
+
+    rate = int(round(sidecar.rate_hz))
+    back = np.array(trajectory_rad[line_index::-1], dtype=float)
+    held = np.array(held_ref_rad, dtype=float)
+    for side in ("left", "right"):
+        back[:, joint_indices(FINGER_JOINTS[side])] = 0.0
+        held[joint_indices(FINGER_JOINTS[side])] = 0.0
+    n = int(RETRACT_OPEN_S * rate)
+    fade = held + np.linspace(0.0, 1.0, n)[:, None] * (back[0] - held)
+    lines = np.vstack([np.repeat(held[None], n, axis=0), fade, back])
+    retract = TrajectoryPlayer(lines, PlayerOptions(rate_hz=rate),
+                               ArmModeSchedule.all_position(len(lines)))
+    monitor = VerdictMonitor(board, sidecar, np.eye(4), opt.verdict)
+    rec = _Recorder(int(math.ceil(retract.duration_s / TICK_S)) + 1, 0)
+    failure, _line = _run_ticks(board, retract, None, controller, monitor, gains, rec,
+                                dataclasses.replace(opt, strategy="position",
+                                                    stop_on_failure=True, record_qpos=False,
+                                                    closed_loop=False),
+                                None, t0_s=board.time_s, settle_s=0.0, holds=False)
+    return failure, 0
+
+
+def _replan_after_touch(robot: str, sidecar: PlanSidecar, ladder: LadderSpec, motion
+                        ) -> tuple[tuple[np.ndarray, PlanSidecar, LadderSpec] | None, dict]:
+    """Plan again (the sidecar's seed and top rung) for ``ladder`` where the motion
+    layer's hands found it (module docstring).
+
+    Returns:
+        The new plan's trajectory, sidecar and ladder (None if the planner found no
+        plan: the run then ends on the layer's stop), and the `SimulationRun.replan`
+        record (``no_plan`` says why there is none).
+    """
+    import tempfile
+    from pathlib import Path
+
+    from planner.output import write_plan
+    from planner.search import ClimbPlanner, PlannerConfig, PlanningFailed
+    from planner.timing import TimingError
+    from robot.plan_sidecar import read_sidecar, sidecar_path
+    from robot.trajectory_file import read_trajectory
+
+    stop = motion.stop
+    stance_m, heading_rad = motion.stance()
+    placed = motion.ladder.placed(ladder, stance_m, heading_rad)
+    metrics = sidecar.metrics or {}
+    config = PlannerConfig(**{k: metrics[k] for k in (
+        "arm_strategy", "position_torque_share", "foot_cop_margin_m", "foot_friction_share")
+        if k in metrics})
+    top = max(int(h.target.removeprefix("rung_")) for limb, h in sidecar.final_holds.items()
+              if limb.endswith("_foot") and h.target.startswith("rung_"))
+    t0 = time.perf_counter()
+    new_plan, no_plan = None, None
+    try:
+        planner = ClimbPlanner(placed, robot=robot, config=config, seed=sidecar.seed)
+        result = planner.plan(top_rung=top)
+        with tempfile.TemporaryDirectory() as tmp:
+            out = Path(tmp) / "replanned.traj"
+            write_plan(result, planner, out, sidecar.rate_hz, {"search_s": result.total_s})
+            new_sidecar = read_sidecar(sidecar_path(out))
+            new_plan = (read_trajectory(out, new_sidecar.rate_hz, new_sidecar.robot),
+                        new_sidecar, placed)
+    except (PlanningFailed, TimingError) as exc:  # the robot keeps holding nothing
+        no_plan = str(exc)
+    record = {"time_s": round(stop.time_s, 3), "line": stop.line,
+              "shift_m": stop.details["shift_m"], "yaw_rad": stop.details["yaw_rad"],
+              "worst_hold_m": stop.details["worst_hold_m"],
+              "placement": {"x_m": round(placed.placement_x_m, 4),
+                            "y_m": round(placed.placement_y_m, 4),
+                            "yaw_rad": round(placed.placement_yaw_rad, 5)},
+              "stance_m": [round(float(v), 4) for v in stance_m[:2]],
+              "stance_heading_rad": round(heading_rad, 5),
+              "planning_s": round(time.perf_counter() - t0, 1), "no_plan": no_plan,
+              "first_plan_motion": motion.report()}
+    return new_plan, record
 
 
 def _placed_board(q0_rad: np.ndarray, sidecar: PlanSidecar, ladder: LadderSpec,
@@ -250,10 +394,14 @@ def _placed_board(q0_rad: np.ndarray, sidecar: PlanSidecar, ladder: LadderSpec,
 
 def _run_ticks(board: BoardModel, player: TrajectoryPlayer, motion, controller: JointController,
                monitor: VerdictMonitor, gains: PwmGains, rec: _Recorder,
-               opt: SimulationOptions, progress: Callable[[float, float], None] | None
+               opt: SimulationOptions, progress: Callable[[float, float], None] | None,
+               t0_s: float = 0.0, settle_s: float | None = None, holds: bool = True
                ) -> tuple[Failure | None, int]:
     """The lock-step loop, one daemon tick per iteration, until the plan has settled, the
     motion layer's hold after a stop is over, or (``opt.stop_on_failure``) a failure.
+    ``t0_s``: the board's time as the player starts [s]; ``settle_s``: how long the
+    robot rests after the last line (the verdict's settling time when None); ``holds``:
+    the monitor checks the plan's holds (False when the player plays other lines).
 
     Returns:
         The first failure the monitor saw (None if none) and the last tick's line index.
@@ -267,9 +415,10 @@ def _run_ticks(board: BoardModel, player: TrajectoryPlayer, motion, controller: 
     finished_at = stopped_at = None
     k = 0
     wall_report = time.perf_counter()
-    expected_s = player.duration_s + opt.verdict.settle_s
+    settle_s = opt.verdict.settle_s if settle_s is None else settle_s
+    expected_s = t0_s + player.duration_s + settle_s
     while True:
-        now = k * TICK_S
+        now = t0_s + k * TICK_S
         pos_now = board.joint_pos()
         vel_now = board.joint_vel()
         if motion is None:
@@ -289,7 +438,7 @@ def _run_ticks(board: BoardModel, player: TrajectoryPlayer, motion, controller: 
             wall_report = time.perf_counter()
             progress(board.time_s, expected_s)
         if failure is None:
-            failure = monitor.check(board.time_s, line_index, trips, grasps)
+            failure = monitor.check(board.time_s, line_index, trips, grasps, holds)
             if failure is not None:
                 log.info("failure: %s", failure.why)
                 if opt.stop_on_failure:
@@ -300,7 +449,7 @@ def _run_ticks(board: BoardModel, player: TrajectoryPlayer, motion, controller: 
                 break
         if tick.finished:
             finished_at = board.time_s if finished_at is None else finished_at
-            if board.time_s - finished_at >= opt.verdict.settle_s - 1e-9:
+            if board.time_s - finished_at >= settle_s - 1e-9:
                 break
     return failure, line_index
 

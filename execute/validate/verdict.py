@@ -139,8 +139,11 @@ class VerdictMonitor:
         return False
 
     # ------------------------------------------------------------------ per tick
-    def check(self, time_s: float, line_index: int, trips, grasps) -> Failure | None:
-        """Checks after one tick; the first failure found, or None."""
+    def check(self, time_s: float, line_index: int, trips, grasps,
+              holds: bool = True) -> Failure | None:
+        """Checks after one tick; the first failure found, or None. ``holds``: check the
+        plan's holds at ``line_index`` too (False while the robot plays something other
+        than the plan's lines: trips, falls and hard contacts only)."""
         line = line_index + 1
         if trips:
             ev = trips[0]
@@ -171,6 +174,8 @@ class VerdictMonitor:
                            f"{self.config.hard_contact_fraction * self.weight_n:.0f} N, "
                            f"{self.config.hard_contact_fraction:.0%} of the robot's weight)",
                            {"body": body, "geom": geom, "force_n": f})
+        if not holds:
+            return None
         seg = self.sidecar.segment_at(line)
         for g in grasps:
             if g.kind == "released":
