@@ -290,3 +290,30 @@ def test_a_misplaced_ladder_is_measured_by_the_first_grasps_and_planned_for_agai
     assert not run.log.latched[0].any()
     assert run.motion["counts"].get("grasp verified", 0) >= 2
     assert run.replan is not None and run.replan["placement_error_before"]["dx_m"] == 0.03
+
+
+def test_a_misplaced_ladder_with_no_new_plan_ends_on_the_stop_with_the_weight_on_the_floor(
+        mount, monkeypatch):
+    """When the planner finds no plan for the ladder as the hands measured it, the run
+    ends on the layer's stop (``ladder_misplaced``, the planner's reason in the record),
+    the robot back at its start with open hands: nothing was loaded onto the ladder."""
+    import planner.search as search
+    from daemon.sim.board_model import PlacementError
+    from execute.motion.config import MotionConfig
+    from primitives.library import climb_sequence
+
+    def no_plan(self, top_rung=None, **_kwargs):
+        raise search.PlanningFailed(climb_sequence(0)[0], "no hold within reach (test)")
+
+    monkeypatch.setattr(search.ClimbPlanner, "plan", no_plan)
+    sc = read_sidecar(sidecar_path(mount))
+    traj = read_trajectory(mount, sc.rate_hz)
+    run = simulate(traj, sc, load_ladder("drc"), SimulationOptions(
+        record_qpos=False, placement=PlacementError(0.03, 0.02, 0.04),
+        motion=MotionConfig(replan_beyond_m=0.02)))
+    failure = run.verdict.failure
+    assert failure is not None and failure.cause.value == "ladder_misplaced"
+    assert "no hold within reach (test)" in run.replan["no_plan"]
+    assert not run.board.latches["left"].latched and not run.board.latches["right"].latched
+    soles_z = [run.board.data.site(f"{s}_sole").xpos[2] for s in "LR"]
+    assert max(soles_z) < 0.01  # both feet still on the floor
