@@ -262,7 +262,7 @@ def test_a_misplaced_ladder_is_measured_by_the_first_grasps_and_planned_for_agai
     def same_lines_for_the_measured_ladder(robot, sidecar, ladder, motion):
         measured["stop"] = motion.stop
         measured["events"] = motion.report()["events"]
-        placed = motion.ladder.placed(ladder, *motion.stance())
+        placed = motion.measured_ladder
         return (traj, sidecar, placed), {"shift_m": motion.stop.details["shift_m"],
                                          "yaw_rad": motion.stop.details["yaw_rad"],
                                          "worst_hold_m": motion.stop.details["worst_hold_m"],

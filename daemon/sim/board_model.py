@@ -93,6 +93,14 @@ class PlacementError:
                              "|dyaw| ≤ π/2 rad")
         return cls(*vals)
 
+    @classmethod
+    def between(cls, planned: LadderSpec, real: LadderSpec) -> PlacementError:
+        """The error that `apply` turns ``planned`` into ``real`` with."""
+        yaw = real.placement_yaw_rad - planned.placement_yaw_rad
+        return cls(real.placement_x_m - planned.placement_x_m,
+                   real.placement_y_m - planned.placement_y_m,
+                   math.atan2(math.sin(yaw), math.cos(yaw)))
+
     def apply(self, ladder: LadderSpec) -> LadderSpec:
         """The ladder as it really stands."""
         yaw = ladder.placement_yaw_rad + self.dyaw_rad

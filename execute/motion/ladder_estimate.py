@@ -28,6 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ladders.geometry import rot_z
 from ladders.spec import LadderSpec
 
 __all__ = ["LadderEstimate", "RailObservation"]
@@ -100,16 +101,12 @@ class LadderEstimate:
         shift = (np.linalg.lstsq(np.vstack(rows), np.concatenate(seen), rcond=None)[0]
                  if rows else np.zeros(2))
         c = self.centre_m[:2]
-        cos, sin = math.cos(self.yaw_rad), math.sin(self.yaw_rad)
-        x, y = spec.placement_x_m - c[0], spec.placement_y_m - c[1]
-        at = np.array([c[0] + cos * x - sin * y + shift[0], c[1] + sin * x + cos * y + shift[1]])
+        origin = np.array([spec.placement_x_m, spec.placement_y_m])
+        at = c + rot_z(self.yaw_rad)[:2, :2] @ (origin - c) + shift
         yaw = spec.placement_yaw_rad + self.yaw_rad
         if stance_m is not None:  # the same pose seen from the stance
-            h = stance_heading_rad
-            d = at - np.asarray(stance_m, dtype=float)[:2]
-            at = np.array([math.cos(h) * d[0] + math.sin(h) * d[1],
-                           -math.sin(h) * d[0] + math.cos(h) * d[1]])
-            yaw -= h
+            at = rot_z(stance_heading_rad)[:2, :2].T @ (at - np.asarray(stance_m)[:2])
+            yaw -= stance_heading_rad
         return dataclasses.replace(spec, placement_x_m=float(at[0]),
                                    placement_y_m=float(at[1]),
                                    placement_yaw_rad=math.atan2(math.sin(yaw), math.cos(yaw)))

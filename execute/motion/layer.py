@@ -278,6 +278,9 @@ class MotionLayer:
         self._sensed_torque_nm = np.zeros(len(JOINT_NAMES))
         self.events: list[MotionEvent] = []
         self.stop: MotionStop | None = None
+        #: the plan's ladder placed where the first grasps found it, seen from where the
+        #: robot stood, when the layer stopped for it (`_misplaced_ladder`)
+        self.measured_ladder: LadderSpec | None = None
         self.estimate: BodyEstimate | None = None
         self._line = 0
         self._now = 0.0
@@ -815,7 +818,9 @@ class MotionLayer:
         if worst_m <= limit_m:
             return False
         shift_m, yaw_rad = self.ladder.shift_m, self.ladder.yaw_rad
-        placed = self.ladder.placed(self.geometry.spec, *self.stance())
+        stance_m, heading_rad = self.stance()
+        placed = self.ladder.placed(self.geometry.spec, stance_m, heading_rad)
+        self.measured_ladder = placed
         placement = {"x_m": round(placed.placement_x_m, 4), "y_m": round(placed.placement_y_m, 4),
                      "yaw_rad": round(placed.placement_yaw_rad, 4)}
         reason = (f"the hands found the ladder shifted {np.round(shift_m[:2] * 100, 1).tolist()} "
@@ -828,7 +833,9 @@ class MotionLayer:
                                FailureCause.LADDER_MISPLACED, 0,
                                {"shift_m": [round(float(v), 4) for v in shift_m],
                                 "yaw_rad": round(float(yaw_rad), 5),
-                                "worst_hold_m": round(worst_m, 4), "placement": placement})
+                                "worst_hold_m": round(worst_m, 4), "placement": placement,
+                                "stance_m": [round(float(v), 4) for v in stance_m[:2]],
+                                "stance_heading_rad": round(heading_rad, 5)})
         self._event(MotionEventKind.STOP, "", worst_m, reason)
         return True
 

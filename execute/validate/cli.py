@@ -254,7 +254,7 @@ def _run(args: argparse.Namespace) -> int:
                           show=lambda done, total: f"{done:.1f}/{total:.1f}") as progress:
         run = simulate(traj, sidecar, ladder, opts, robot,
                        progress=lambda sim_s, total_s: progress.update(sim_s, total=total_s))
-    if run.replan is not None:  # the run climbed a new plan, for the ladder as measured
+    if run.replan is not None:  # the plan played: the new one, or the first if none was found
         traj, sidecar, ladder = run.trajectory_rad, run.sidecar, run.ladder
         print(replan_summary(run.replan), flush=True)
     metrics = compute_metrics(run)

@@ -252,11 +252,7 @@ def simulate(trajectory_rad: np.ndarray, sidecar: PlanSidecar, ladder: LadderSpe
         if new_plan is not None:
             trajectory_rad, sidecar, ladder = new_plan
             replan["placement_error_before"] = dataclasses.asdict(opt.placement)
-            yaw = real_ladder.placement_yaw_rad - ladder.placement_yaw_rad
-            opt = dataclasses.replace(opt, placement=PlacementError(
-                real_ladder.placement_x_m - ladder.placement_x_m,
-                real_ladder.placement_y_m - ladder.placement_y_m,
-                math.atan2(math.sin(yaw), math.cos(yaw))))
+            opt = dataclasses.replace(opt, placement=PlacementError.between(ladder, real_ladder))
             schedule, compliant = _schedule(opt.strategy, sidecar, len(trajectory_rad))
             player = TrajectoryPlayer(trajectory_rad,
                                       PlayerOptions(rate_hz=rate, compliant_arms=compliant,
@@ -266,9 +262,8 @@ def simulate(trajectory_rad: np.ndarray, sidecar: PlanSidecar, ladder: LadderSpe
             motion = MotionLayer(player, trajectory_rad, sidecar, ladder, robot,
                                  dataclasses.replace(opt.motion or MotionConfig(),
                                                      replan_beyond_m=0.0))
-            T_err = LadderGeometry(opt.placement.apply(ladder)).T_world_ladder @ np.linalg.inv(
-                LadderGeometry(ladder).T_world_ladder)
-            monitor = VerdictMonitor(board, sidecar, T_err, opt.verdict)
+            monitor = VerdictMonitor(board, sidecar, _misplacement(ladder, opt.placement),
+                                     opt.verdict)
             rec = _Recorder(int(math.ceil((player.duration_s + opt.verdict.settle_s)
                                           / TICK_S)),
                             board.model.nq if opt.record_qpos else 0)
@@ -340,14 +335,13 @@ def _replan_after_touch(robot: str, sidecar: PlanSidecar, ladder: LadderSpec, mo
     from robot.trajectory_file import read_trajectory
 
     stop = motion.stop
-    stance_m, heading_rad = motion.stance()
-    placed = motion.ladder.placed(ladder, stance_m, heading_rad)
+    placed = motion.measured_ladder
     metrics = sidecar.metrics or {}
     config = PlannerConfig(**{k: metrics[k] for k in (
         "arm_strategy", "position_torque_share", "foot_cop_margin_m", "foot_friction_share")
         if k in metrics})
-    top = max(int(h.target.removeprefix("rung_")) for limb, h in sidecar.final_holds.items()
-              if limb.endswith("_foot") and h.target.startswith("rung_"))
+    top = max(h.hold_target.rung for limb, h in sidecar.final_holds.items()
+              if Limb(limb).is_foot and h.hold_target.kind is HoldTargetKind.RUNG)
     t0 = time.perf_counter()
     new_plan, no_plan = None, None
     try:
@@ -364,11 +358,7 @@ def _replan_after_touch(robot: str, sidecar: PlanSidecar, ladder: LadderSpec, mo
     record = {"time_s": round(stop.time_s, 3), "line": stop.line,
               "shift_m": stop.details["shift_m"], "yaw_rad": stop.details["yaw_rad"],
               "worst_hold_m": stop.details["worst_hold_m"],
-              "placement": {"x_m": round(placed.placement_x_m, 4),
-                            "y_m": round(placed.placement_y_m, 4),
-                            "yaw_rad": round(placed.placement_yaw_rad, 5)},
-              "stance_m": [round(float(v), 4) for v in stance_m[:2]],
-              "stance_heading_rad": round(heading_rad, 5),
+              **{k: stop.details[k] for k in ("placement", "stance_m", "stance_heading_rad")},
               "planning_s": round(time.perf_counter() - t0, 1), "no_plan": no_plan,
               "first_plan_motion": motion.report()}
     return new_plan, record
@@ -379,17 +369,21 @@ def _placed_board(q0_rad: np.ndarray, sidecar: PlanSidecar, ladder: LadderSpec,
     """The board model on the ladder as placed (``opt.placement``), the robot at rest in
     pose ``q0_rad`` with its soles where the plan's first segment puts them on the floor;
     and T_err, the (4, 4) transform from the planned ladder to the placed one."""
-    real_ladder = opt.placement.apply(ladder)
-    board = BoardModel(real_ladder, robot, opt.board)
-    T_err = LadderGeometry(real_ladder).T_world_ladder @ np.linalg.inv(
-        LadderGeometry(ladder).T_world_ladder)
+    board = BoardModel(opt.placement.apply(ladder), robot, opt.board)
     first = sidecar.segments[0] if sidecar.segments else None
     soles = None
     if first is not None:
         soles = {Limb(k).side.value: np.asarray(h.position_m) for k, h in first.holds.items()
                  if Limb(k).is_foot and h.hold_target.kind is HoldTargetKind.FLOOR}
     board.reset(q0_rad, soles or None)
-    return board, T_err
+    return board, _misplacement(ladder, opt.placement)
+
+
+def _misplacement(ladder: LadderSpec, placement: PlacementError) -> np.ndarray:
+    """T_err: the (4, 4) transform from ``ladder`` as planned to ``ladder`` as
+    ``placement`` puts it."""
+    return LadderGeometry(placement.apply(ladder)).T_world_ladder @ np.linalg.inv(
+        LadderGeometry(ladder).T_world_ladder)
 
 
 def _run_ticks(board: BoardModel, player: TrajectoryPlayer, motion, controller: JointController,
