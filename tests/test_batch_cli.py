@@ -21,8 +21,10 @@ sys.path.insert(0, str(Path(__file__).parent))
 import batch_small_jobs as small  # noqa: E402
 
 from execute.batch.cli import main, parse_args, run  # noqa: E402
-from execute.batch.jobs import JobFunctions  # noqa: E402
+from execute.batch.jobs import JobFunctions, expand_jobs  # noqa: E402
+from execute.batch.perturb import parse_perturb  # noqa: E402
 from execute.batch.runner import RESULTS_FILE  # noqa: E402
+from ladders.loader import load_ladder  # noqa: E402
 from robot.vocabulary import FailureCause  # noqa: E402
 
 SMALL = JobFunctions(plan=small.small_plan, validate=small.small_validate)
@@ -47,6 +49,9 @@ SMALL = JobFunctions(plan=small.small_plan, validate=small.small_validate)
     (["--ladders", "stair", "--top-rung", "4"], ["--top-rung is 4", "0..3"]),
     (["--ladders", "drc", "--sweep", "s.yaml"], ["not allowed with argument"]),
     (["--plans-from", "no-such-dir"], ["--plans-from", "no-such-dir", "results.jsonl"]),
+    (["--replan-beyond", "0.5"], ["--replan-beyond", "replan_beyond_m = 0.5", "[0, 0.2]"]),
+    (["--replan-beyond", "0.02", "--loop", "open"], ["--replan-beyond is 0.02",
+                                                     "only closed-loop runs plan again"]),
 ])
 def test_bad_flags_exit_2_naming_the_option(argv, words, tmp_path, capsys):
     assert main([*argv, "--out", str(tmp_path)]) == 2
@@ -93,20 +98,40 @@ def test_small_run_prints_and_writes_tables_and_plots(tmp_path):
     assert len(records) == 2 * 4 + 2 * 4 * 3 * 2
 
 
-def test_loop_axis_pairs_open_and_closed_runs_on_the_same_draws(tmp_path):
-    out = tmp_path / "o"
+def _both_loops(out: Path, *extra: str) -> tuple[list[str], list[dict]]:
+    """A small mixed batch on drc seeds 1–2, closed and open loop: (summary rows'
+    labels, validate records)."""
     code, _text = _run_small(["--ladders", "drc", "--seeds", "2", "--strategies", "mixed",
-                              "--loop", "closed,open", "--perturb", "placement=0.03",
-                              "--workers", "1", "--out", str(out)])
+                              "--loop", "closed,open", *extra, "--workers", "1",
+                              "--out", str(out)])
     assert code == 0
     rows = list(csv.DictReader((out / "summary.csv").open()))
-    assert [r["strategy"] for r in rows] == ["mixed closed", "mixed open"]
     records = [json.loads(x) for x in (out / RESULTS_FILE).read_text().splitlines()]
-    runs = [r for r in records if r["kind"] == "validate"]
+    return [r["strategy"] for r in rows], [r for r in records if r["kind"] == "validate"]
+
+
+def test_loop_axis_pairs_open_and_closed_runs_on_the_same_draws(tmp_path):
+    labels, runs = _both_loops(tmp_path / "o", "--perturb", "placement=0.03")
+    assert labels == ["mixed closed", "mixed open"]
     assert sorted(r["loop"] for r in runs) == ["closed", "closed", "open", "open"]
     for seed in (1, 2):
         pair = [r["perturbation"] for r in runs if r["seed"] == seed]
         assert len(pair) == 2 and pair[0] == pair[1]
+
+
+def test_re_planning_closed_runs_get_their_own_row_and_fingerprint(tmp_path):
+    """``--replan-beyond`` reaches the closed runs only, names their row, and changes
+    their fingerprint (a batch without it resumes from its old records)."""
+    labels, runs = _both_loops(tmp_path / "o", "--replan-beyond", "0.02")
+    assert labels == ["mixed closed, re-plan > 2 cm", "mixed open"]
+    assert sorted((r["loop"], r.get("replan_beyond_m")) for r in runs) == [
+        ("closed", 0.02), ("closed", 0.02), ("open", None), ("open", None)]
+    jobs = expand_jobs([("drc", load_ladder("drc"), {})], [1], ["mixed"],
+                       parse_perturb(""), loops=("closed",))[1]
+    again = expand_jobs([("drc", load_ladder("drc"), {})], [1], ["mixed"],
+                        parse_perturb(""), loops=("closed",), replan_beyond_m=0.02)[1]
+    assert jobs[0].fingerprint != again[0].fingerprint
+    assert "replan_beyond_m" not in jobs[0].describe()
 
 
 def test_small_sweep_run_writes_a_heat_map(tmp_path):
@@ -165,7 +190,8 @@ def test_real_plan_and_validate_on_the_stair_first_rung(tmp_path, capsys):
     with the three strategies (each ends within ~20 s of simulated time)."""
     out = tmp_path / "real"
     code = main(["--ladders", "stair", "--top-rung", "0", "--seeds", "1", "--perturb",
-                 "placement=0.01", "--workers", "2", "--out", str(out), "--no-plots"])
+                 "placement=0.01", "--replan-beyond", "0.05", "--workers", "2",
+                 "--out", str(out), "--no-plots"])
     text = capsys.readouterr().out
     assert code == 0, text
     recs = {r["key"]: r for r in map(json.loads, (out / RESULTS_FILE).read_text().splitlines())}
@@ -178,6 +204,7 @@ def test_real_plan_and_validate_on_the_stair_first_rung(tmp_path, capsys):
         if plan["outcome"] == "planned":
             # the record carries validate-plan's own result: cause, why and metrics
             assert r["result"]["strategy"] == r["strategy"]
+            assert r["result"]["replan_beyond_m"] == 0.05  # the motion layer got the option
             assert r["result"]["placement_error"]["dx_m"] == r["perturbation"]["dx_m"]
             assert r["outcome"] == "climbed" or r["cause"] in causes
             assert r["why"] and r["simulated_s"] > 0

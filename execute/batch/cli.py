@@ -1,7 +1,7 @@
 """``batch-eval``: success rates over ladders × seeds × strategies × perturbations.
 
     batch-eval [--ladders drc,ship,stair | --sweep SWEEP.yaml] [--seeds N] [--first-seed S]
-               [--strategies mixed,position,pwm] [--loop closed,open]
+               [--strategies mixed,position,pwm] [--loop closed,open] [--replan-beyond M]
                [--perturb KEY=V,...] [--draws D]
                [--engine local|dask] [--address tcp://host:8786] [--workers K]
                [--out DIR] [--plans-from DIR] [--time-limit S] [--top-rung K] [--robot R]
@@ -33,6 +33,7 @@ import sys
 import time
 from pathlib import Path
 
+from execute.motion.config import MotionConfig, MotionConfigError
 from robot.constants import DAEMON_RATE_HZ
 from robot.errors import HuboLadderError, InputError, run_cli
 from robot.vocabulary import ArmStrategy
@@ -61,6 +62,11 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--loop", default="closed", metavar="closed,open",
                    help="play each plan through the motion layer (closed), as the file is "
                         "(open), or both, on the same perturbation draws (default closed)")
+    p.add_argument("--replan-beyond", type=float, default=0.0, metavar="M",
+                   help="closed loop: when the first two grasps find the plan's holds further "
+                        "than M from the real ones, plan again for the ladder where the hands "
+                        "found it and climb that plan (validate-plan --replan-beyond); within "
+                        "[0, 0.2], 0 never (default 0)")
     p.add_argument("--perturb", default="", metavar="KEY=V,...",
                    help="placement=M,yaw=RAD,rung=M,friction=LO:HI,battery=LO:HI")
     p.add_argument("--draws", type=int, default=1, metavar="D",
@@ -104,10 +110,9 @@ def parse_args(argv: list[str] | None = None) -> dict:
 
     Returns:
         A dict with ``ladders`` ([(key, spec, sweep values)]), ``seeds``, ``strategies``,
-        ``perturb`` (`PerturbSpec`), ``draws``, ``engine``, ``address``, ``workers``,
-        ``out``, ``plans_from``, ``time_limit_s``, ``top_rung``, ``robot``, ``rate_hz``,
-        ``max_jobs``,
-        ``plots``, ``verbose``.
+        ``loops``, ``replan_beyond_m``, ``perturb`` (`PerturbSpec`), ``draws``,
+        ``engine``, ``address``, ``workers``, ``out``, ``plans_from``, ``time_limit_s``,
+        ``top_rung``, ``robot``, ``rate_hz``, ``max_jobs``, ``plots``, ``verbose``.
 
     Raises:
         InputError: naming the option or ``FILE:LINE`` and the allowed values.
@@ -127,6 +132,9 @@ def parse_args(argv: list[str] | None = None) -> dict:
     bad = [x for x in loops if x not in LOOPS]
     if bad or len(set(loops)) != len(loops):
         raise InputError(f"option --loop is {a.loop!r}; give closed, open or closed,open")
+    if a.replan_beyond and "closed" not in loops:
+        raise InputError(f"option --replan-beyond is {a.replan_beyond:g}, but --loop is "
+                         f"{a.loop!r}: only closed-loop runs plan again")
     perturb = parse_perturb(a.perturb)
     if a.draws > 1 and not perturb:
         raise InputError(f"option --draws is {a.draws}, but there is no --perturb: every draw "
@@ -142,7 +150,8 @@ def parse_args(argv: list[str] | None = None) -> dict:
                          "(give the --out directory of an earlier batch-eval run)")
     workers = a.workers or os.cpu_count() or 1
     return {"ladders": ladders, "seeds": list(range(a.first_seed, a.first_seed + a.seeds)),
-            "strategies": strategies, "loops": loops, "perturb": perturb, "draws": a.draws,
+            "strategies": strategies, "loops": loops, "replan_beyond_m": a.replan_beyond,
+            "perturb": perturb, "draws": a.draws,
             "engine": a.engine, "address": a.address, "workers": workers, "out": Path(a.out),
             "plans_from": None if a.plans_from is None else Path(a.plans_from),
             "time_limit_s": a.time_limit, "top_rung": a.top_rung, "robot": a.robot,
@@ -166,6 +175,10 @@ def _check_scalar_options(a: argparse.Namespace) -> None:
             ("--top-rung", a.top_rung, a.top_rung is None or a.top_rung >= 0, "≥ 0")):
         if not ok:
             raise InputError(f"option {name} is {value:g}; it must be {rule}")
+    try:
+        MotionConfig(replan_beyond_m=a.replan_beyond)
+    except MotionConfigError as exc:
+        raise InputError(f"option --replan-beyond: {exc}") from None
     if a.engine not in ("local", "dask"):
         raise InputError(f"option --engine is {a.engine!r}; choose local or dask")
     if a.address is not None:
@@ -217,7 +230,8 @@ def run(opts: dict, console, err, functions=None, engine=None) -> int:
                                      opts["perturb"], opts["draws"], robot=opts["robot"],
                                      time_limit_s=opts["time_limit_s"],
                                      top_rung=opts["top_rung"], rate_hz=opts["rate_hz"],
-                                     loops=opts["loops"])
+                                     loops=opts["loops"],
+                                     replan_beyond_m=opts.get("replan_beyond_m", 0.0))
     out: Path = opts["out"]
     out.mkdir(parents=True, exist_ok=True)
     if opts.get("plans_from") is not None:
@@ -303,7 +317,8 @@ def _write_reports(batch, plans, validations, opts: dict, console) -> list[Path]
     for p in plans:
         expected_plans[p.ladder_key] = expected_plans.get(p.ladder_key, 0) + 1
     summary = summarize_records(batch.records, {k: s for k, s, _ in opts["ladders"]},
-                                [run_label(s, lp) for s in opts["strategies"]
+                                [run_label(s, lp, opts.get("replan_beyond_m", 0.0))
+                                 for s in opts["strategies"]
                                  for lp in opts["loops"]], expected, expected_plans)
     print_summary(summary, console)
     files = [write_csv(summary, out / "summary.csv"), write_markdown(summary, out / "summary.md")]

@@ -112,6 +112,9 @@ class ValidateJob:
         draw_index: index of the perturbation draw (0-based).
         draw: the drawn perturbation (the same for both loops: runs pair up).
         loop: ``closed`` (through the motion layer) or ``open`` (the file as it is).
+        replan_beyond_m: closed loop: plan again after the first two grasps when they find
+            a hold further than this from the plan's [m] (`MotionConfig.replan_beyond_m`;
+            0 never).
     """
 
     plan: PlanJob
@@ -119,6 +122,7 @@ class ValidateJob:
     draw_index: int
     draw: Draw
     loop: str = "closed"
+    replan_beyond_m: float = 0.0
 
     kind = "validate"
 
@@ -129,39 +133,54 @@ class ValidateJob:
 
     @property
     def fingerprint(self) -> str:
-        return _fingerprint({"kind": "validate", "plan": self.plan.fingerprint,
-                             "strategy": self.strategy, "loop": self.loop,
-                             "draw": self.draw.to_json()})
+        identity = {"kind": "validate", "plan": self.plan.fingerprint,
+                    "strategy": self.strategy, "loop": self.loop, "draw": self.draw.to_json()}
+        if self.replans:  # absent when off, so batches from before the option still resume
+            identity["replan_beyond_m"] = self.replan_beyond_m
+        return _fingerprint(identity)
+
+    @property
+    def replans(self) -> bool:
+        """Whether the run may plan again after its first touch (closed loop only)."""
+        return self.loop == "closed" and self.replan_beyond_m > 0
 
     def describe(self) -> dict:
         return {"key": self.key, "fingerprint": self.fingerprint, "kind": self.kind,
                 "ladder": self.plan.ladder_key, "seed": self.plan.seed,
                 "sweep": dict(self.plan.sweep), "strategy": self.strategy,
                 "loop": self.loop, "draw": self.draw_index,
-                "perturbation": self.draw.to_json()}
+                "perturbation": self.draw.to_json()} | (
+                    {"replan_beyond_m": self.replan_beyond_m} if self.replans else {})
 
     @property
     def label(self) -> str:
         """The row of the summary this run counts in."""
-        return run_label(self.strategy, self.loop)
+        return run_label(self.strategy, self.loop,
+                         self.replan_beyond_m if self.replans else 0.0)
 
 
-def run_label(strategy: str, loop: str) -> str:
-    """``"mixed closed"``: a strategy played open or closed loop."""
-    return f"{strategy} {loop}"
+def run_label(strategy: str, loop: str, replan_beyond_m: float = 0.0) -> str:
+    """``"mixed closed"``: a strategy played open or closed loop;
+    ``"mixed closed, re-plan > 2 cm"`` when a closed run may plan again after its first
+    touch."""
+    label = f"{strategy} {loop}"
+    if loop == "closed" and replan_beyond_m > 0:
+        label += f", re-plan > {replan_beyond_m * 100:g} cm"
+    return label
 
 
 def record_label(record: dict) -> str:
     """The summary row of a validate record (records written before the loop axis
     existed were open loop)."""
-    return run_label(record["strategy"], record.get("loop", "open"))
+    return run_label(record["strategy"], record.get("loop", "open"),
+                     record.get("replan_beyond_m", 0.0))
 
 
 def expand_jobs(ladders: Sequence[tuple[str, LadderSpec, dict[str, Any]]], seeds: Sequence[int],
                 strategies: Sequence[str], perturb: PerturbSpec, draws: int = 1, *,
                 robot: str = "drc-hubo", time_limit_s: float = 600.0,
                 top_rung: int | None = None, rate_hz: float = DAEMON_RATE_HZ,
-                loops: Sequence[str] = ("closed",)
+                loops: Sequence[str] = ("closed",), replan_beyond_m: float = 0.0
                 ) -> tuple[list[PlanJob], list[ValidateJob]]:
     """Every job of a batch.
 
@@ -173,6 +192,7 @@ def expand_jobs(ladders: Sequence[tuple[str, LadderSpec, dict[str, Any]]], seeds
         draws: perturbation draws per (plan, strategy).
         robot, time_limit_s, top_rung, rate_hz: planning settings (see `PlanJob`).
         loops: ``closed`` and/or ``open``; both loops of a strategy see the same draws.
+        replan_beyond_m: closed runs plan again beyond this first-touch error [m] (0 never).
 
     Returns:
         (plan jobs, validate jobs), in ladder, seed, strategy, loop, draw order.
@@ -187,7 +207,8 @@ def expand_jobs(ladders: Sequence[tuple[str, LadderSpec, dict[str, Any]]], seeds
                 for loop in loops:
                     for i in range(draws):
                         validations.append(ValidateJob(
-                            p, strategy, i, draw(perturb, key, int(seed), strategy, i), loop))
+                            p, strategy, i, draw(perturb, key, int(seed), strategy, i), loop,
+                            replan_beyond_m))
     return plans, validations
 
 
@@ -256,6 +277,7 @@ def validate_job(job: ValidateJob, plan_outcome: dict, out_dir: str) -> dict:
         climb (a failed run stops early, so its time per rung means nothing).
     """
     from daemon.sim.board_model import BoardModelConfig, PlacementError
+    from execute.motion.config import MotionConfig
     from execute.validate.cli import result_json
     from execute.validate.metrics import compute_metrics
     from execute.validate.plan_compare import compare_with_plan
@@ -270,7 +292,8 @@ def validate_job(job: ValidateJob, plan_outcome: dict, out_dir: str) -> dict:
     opts = SimulationOptions(strategy=job.strategy,
                              placement=PlacementError(d.dx_m, d.dy_m, d.dyaw_rad),
                              board=BoardModelConfig(battery_v=d.battery_v), record_qpos=False,
-                             closed_loop=job.loop == "closed")
+                             closed_loop=job.loop == "closed",
+                             motion=MotionConfig(replan_beyond_m=job.replan_beyond_m))
     run = simulate(traj, sidecar, d.physical_ladder(job.plan.ladder), opts, sidecar.robot)
     metrics = compute_metrics(run)
     result = result_json(run, metrics, plan_outcome["traj"],

@@ -200,6 +200,8 @@ def result_json(run, metrics, plan_path: str, comparison=None) -> dict:
         "metrics": metrics.to_json(),
         "plan_vs_sim": None if comparison is None else comparison.to_json(),
         "motion": run.motion,
+        "replan_beyond_m": ((run.options.motion or MotionConfig()).replan_beyond_m
+                            if run.options.closed_loop else None),
         "replan": run.replan,
     }
 
