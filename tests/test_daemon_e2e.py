@@ -8,6 +8,7 @@ assert behaviour (modes, holds, stance), never timing.
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import select
 import signal
@@ -34,6 +35,7 @@ from daemon.structs import (  # noqa: E402
     StatusFlag,
     new_sample,
 )
+from ladders.loader import dump_ladder, load_ladder  # noqa: E402
 from robot.joints import ARM_JOINTS, JOINT_INDEX, LEG_JOINTS  # noqa: E402
 from robot.plan_sidecar import read_sidecar, sidecar_path  # noqa: E402
 from robot.trajectory_file import read_trajectory  # noqa: E402
@@ -297,3 +299,43 @@ def test_faults_player_killed_two_writers_and_a_daemon_restart(plan, tmp_path):
     assert ref[killed, JOINT_INDEX["LSR"]] > 0.3  # where it was, not back at the start
     rec2 = read_state_log(tmp_path / "restart.log")
     assert rec2["tick"][0] == 1 and len(rec2) > 50
+
+
+def test_a_misplaced_ladder_stops_the_player_which_writes_it_and_retraces_the_plan(
+        plan, tmp_path):
+    """``play-trajectory --replan-beyond`` on a ladder 1.2 cm from the plan's: both grasps
+    find it there, the motion layer stops before the ladder takes any weight, the ladder
+    as measured is written, the hands open and the arms retrace the plan to its first
+    line; exit 1 with the command that plans again."""
+    spec = load_ladder("drc")
+    real = dataclasses.replace(spec, placement_y_m=spec.placement_y_m + 0.012)
+    dump_ladder(real, tmp_path / "real.yaml")
+    measured = tmp_path / "measured.yaml"
+    d = Daemon(tmp_path, "replan", "--backend", "sim", "--homed",
+               "--ladder", str(tmp_path / "real.yaml"))
+    try:
+        d.start()
+        d.wait_until(lambda s: not np.any(s["status"] & int(StatusFlag.NOT_HOMED)))
+        r = play(d.instance, "-n", str(plan), "-i", "--replan-beyond", "0.005",
+                 "--measured-ladder", str(measured))
+        time.sleep(0.5)
+        d.stop()
+    finally:
+        d.close()
+    assert r.returncode == 1, r.stderr
+    assert "ladder_misplaced" not in r.stderr  # said in words, not as a code
+    assert "the weight was not moved onto the ladder" in r.stderr
+    assert f"wrote the ladder as the hands found it to {measured}" in r.stderr
+    assert "back at the plan's start" in r.stderr and f"plan-ladder {measured}" in r.stderr
+    found = load_ladder(str(measured))
+    # within a centimetre: the real-time daemon's runs differ by a few millimetres
+    assert abs(found.placement_y_m - real.placement_y_m) < 0.01
+    assert abs(found.placement_x_m - real.placement_x_m) < 0.01
+    rec = d.records()
+    assert rec["latched"].any(axis=0).all(), "both hands held their rails on the way"
+    assert not rec["latched"][-1].any(), "and let go of them"
+    assert np.all(rec["ft"]["fz"][-1, :2] > 100.0)  # standing on both feet throughout
+    sc = read_sidecar(sidecar_path(plan))
+    first = read_trajectory(plan, sc.rate_hz)[0]
+    arms = [JOINT_INDEX[n] for side in ("left", "right") for n in ARM_JOINTS[side]]
+    assert np.abs(rec["pos"][-1, arms] - first[arms]).max() < 0.05  # back at the start

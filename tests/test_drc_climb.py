@@ -21,6 +21,7 @@ import json
 import numpy as np
 import pytest
 
+from execute.motion.retract import RETRACT_OPEN_S
 from execute.validate.cli import main as validate_main
 from execute.validate.simulate import SimulationOptions, simulate
 from ladders.loader import load_ladder
@@ -286,7 +287,7 @@ def test_a_misplaced_ladder_is_measured_by_the_first_grasps_and_planned_for_agai
     assert stop.details["placement"]["yaw_rad"] == pytest.approx(run.ladder.placement_yaw_rad,
                                                                 abs=1e-4)
     # the second run starts after the retreat, both hands open, and grasps again
-    assert run.log.time_s[0] > stop.time_s + sim.RETRACT_OPEN_S
+    assert run.log.time_s[0] > stop.time_s + RETRACT_OPEN_S
     assert not run.log.latched[0].any()
     assert run.motion["counts"].get("grasp verified", 0) >= 2
     assert run.replan is not None and run.replan["placement_error_before"]["dx_m"] == 0.03

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import argparse
 import math
 from dataclasses import dataclass, field
 
@@ -157,3 +158,47 @@ class MotionConfig:
 
 def default_config() -> MotionConfig:
     return MotionConfig()
+
+
+def add_motion_arguments(parser: argparse.ArgumentParser) -> None:
+    """The motion layer's flags, shared by ``validate-plan`` and ``play-trajectory`` (the
+    same layer runs in simulation and on the robot); `motion_config_from_args` reads
+    them."""
+    cfg = MotionConfig()
+
+    def within(name: str) -> str:
+        lo, hi = _RANGES[name]
+        return f"within [{lo:g}, {hi:g}] (default {getattr(cfg, name):g})"
+
+    parser.add_argument("--max-reach-correction", type=float,
+                        default=cfg.max_reach_correction_m, metavar="M",
+                        help="closed loop: largest shift of a hold target [m], "
+                             + within("max_reach_correction_m"))
+    parser.add_argument("--grasp-retries", type=int, default=cfg.grasp_retries, metavar="N",
+                        help="closed loop: re-reaches of a hand that closed on nothing, "
+                             + within("grasp_retries"))
+    parser.add_argument("--holding-arm-stiffness", type=float,
+                        default=cfg.holding_arm_stiffness, metavar="S",
+                        help="closed loop: share of the PWM stiffness pulling a gripping arm "
+                             "towards the plan, " + within("holding_arm_stiffness"))
+    parser.add_argument("--replan-beyond", type=float, default=cfg.replan_beyond_m,
+                        metavar="M",
+                        help="closed loop: when the first two grasps find the plan's holds "
+                             "further than M [m] from the real ones, stop before the ladder "
+                             "takes any weight, open the hands and retrace the plan to its "
+                             "start; validate-plan then plans again for the ladder where the "
+                             "hands found it and climbs that plan, play-trajectory writes "
+                             "that ladder for plan-ladder; " + within("replan_beyond_m")
+                             + ", 0 never")
+
+
+def motion_config_from_args(args: argparse.Namespace) -> MotionConfig:
+    """The motion layer's settings from `add_motion_arguments`' flags.
+
+    Raises:
+        MotionConfigError: a value outside its safe range (exit 2, naming it).
+    """
+    return MotionConfig(max_reach_correction_m=args.max_reach_correction,
+                        grasp_retries=args.grasp_retries,
+                        holding_arm_stiffness=args.holding_arm_stiffness,
+                        replan_beyond_m=args.replan_beyond)

@@ -2,7 +2,8 @@
 
     play-trajectory -n FILE [-f 10|25|50|100|200|500] [-i] [-c|-cl|-cr] [-nf] [-p]
                     [-line N] [--open-loop] [--no-auto-modes] [--instance NAME] [--robot R]
-                    [--clamp-limits TOL]
+                    [--clamp-limits TOL] [--max-reach-correction M] [--grasp-retries N]
+                    [--holding-arm-stiffness S] [--replan-beyond M [--measured-ladder F]]
 
 Before anything is sent, the whole file is checked (`robot.trajectory_file`): a bad file
 exits 2 naming ``FILE:LINE:COLUMN``, and the ``ref`` channel is never written. Values
@@ -31,7 +32,12 @@ reads the daemon's ``state`` channel every tick, checks every grasp from the fin
 encoders before the plan loads it, re-reaches a miss, re-targets later reaches and
 compensates the compliant arms' gravity; it first sets the arms' PWM clamps to the
 safety ceiling on the daemon's ``pwm-gains`` channel (`execute.motion.gains`). If a
-grasp cannot be made it stops and holds (exit 1). ``--open-loop`` plays the file as
+grasp cannot be made it stops and holds (exit 1). Its flags are `validate-plan`'s
+(`execute.motion.config.add_motion_arguments`). With ``--replan-beyond M``, when the
+first two grasps find the plan's holds more than M from the real ones, it stops before the
+ladder takes any weight, writes the ladder as the hands found it (``--measured-ladder``),
+opens the hands, retraces the plan to its first line (`execute.motion.retract`) and prints
+the ``plan-ladder`` command for a new plan (exit 1). ``--open-loop`` plays the file as
 hubo-read-trajectory did.
 
 It streams one ``ref`` sample per 5 ms (absolute deadlines), ``playing`` set, and shows
@@ -58,7 +64,9 @@ from pathlib import Path
 
 import numpy as np
 
+from execute.motion.config import add_motion_arguments, motion_config_from_args
 from robot.errors import HuboLadderError, InputError, run_cli
+from robot.vocabulary import FailureCause
 
 __all__ = ["main"]
 
@@ -108,6 +116,10 @@ def _parser() -> argparse.ArgumentParser:
                    help="clamp values at most TOL [rad] (up to 0.1) beyond a joint limit onto "
                         "it, with a per-joint report; farther ones are refused (default: "
                         "strict, every value within the limits)")
+    add_motion_arguments(p)
+    p.add_argument("--measured-ladder", metavar="SPEC.yaml", default=None,
+                   help="with --replan-beyond: where to write the ladder as the hands found "
+                        "it (default: beside FILE, FILE's name with .measured-ladder.yaml)")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress line")
     return p
 
@@ -148,13 +160,14 @@ def _load(args):
     if not (np.isfinite(args.line_tolerance) and args.line_tolerance > 0):
         raise InputError(f"--line-tolerance {args.line_tolerance}: must be > 0 [rad]")
     player = TrajectoryPlayer(traj, opts, schedule, sidecar.arm_feedforward if auto else None)
+    config = motion_config_from_args(args)
     motion = None
     if auto and not args.open_loop:
         from execute.motion.layer import MotionLayer
         from execute.validate.cli import ladder_from_sidecar
 
         ladder = ladder_from_sidecar(sidecar.ladder, f"{side}: ladder")
-        motion = MotionLayer(player, traj, sidecar, ladder, robot)
+        motion = MotionLayer(player, traj, sidecar, ladder, robot, config)
     return traj, player, auto, motion
 
 
@@ -329,6 +342,8 @@ def _stream(args, player, motion, ref, state, limits, signals: _Signals, keys) -
             print(f"\nplay-trajectory: the motion layer stopped at line "
                   f"{motion.stop.line} and holds: {motion.stop.reason}",
                   file=sys.stderr, flush=True)
+            if motion.stop.cause is FailureCause.LADDER_MISPLACED:
+                return _retreat(args, motion, tick, ref, state, limits, signals, keys)
             return 1
         _fill_ref_sample(sample, tick, player, latest, motors, DEFAULT_BATTERY_V)
         ref.write(sample)
@@ -350,6 +365,45 @@ def _stream(args, player, motion, ref, state, limits, signals: _Signals, keys) -
     print(f"\nplay-trajectory: stopped at {where}; the robot holds the last reference",
           file=sys.stderr, flush=True)
     return 130
+
+
+def _retreat(args, motion, tick, ref, state, limits, signals: _Signals, keys) -> int:
+    """After a ``ladder_misplaced`` stop: write the ladder as the hands found it, then
+    retrace the plan to its first line with open hands (`execute.motion.retract`), and
+    say how to plan again. Returns 1 (the plan was not played), or 130 if a signal
+    stopped the way back (holding)."""
+    from execute.motion.replan import ReplanSettings
+    from execute.motion.retract import retract_lines
+    from execute.play.arm_modes import ArmModeSchedule
+    from execute.play.player import PlayerOptions, TrajectoryPlayer
+    from ladders.loader import dump_ladder
+    from robot.plan_sidecar import sidecar_path
+
+    stem = str(sidecar_path(Path(args.file))).removesuffix(".plan.json")
+    spec_path = Path(args.measured_ladder or f"{stem}.measured-ladder.yaml")
+    try:  # first: the measurement is kept even if the way back is interrupted
+        dump_ladder(motion.measured_ladder, spec_path)
+        print(f"play-trajectory: wrote the ladder as the hands found it to {spec_path}",
+              file=sys.stderr, flush=True)
+    except OSError as exc:
+        print(f"play-trajectory: could not write {spec_path} ({exc.strerror}); the "
+              f"placement is in the message above", file=sys.stderr, flush=True)
+    rate = motion.player.options.rate_hz
+    lines = retract_lines(motion.trajectory_rad, tick.line_number - 1,
+                          motion.last_reference_rad, rate)
+    back = TrajectoryPlayer(lines, PlayerOptions(rate_hz=rate),
+                            ArmModeSchedule.all_position(len(lines)))
+    print(f"play-trajectory: opening the hands and retracing the plan to its first line "
+          f"({back.duration_s:.1f} s, position mode)", file=sys.stderr, flush=True)
+    code = _stream(args, back, None, ref, state, limits, signals, keys)
+    if code != 0:
+        return code
+    new = f"{stem}.replanned.traj"
+    print("play-trajectory: back at the plan's start, weight on the floor. Plan again for "
+          f"the measured ladder, then play the new plan:\n  "
+          f"{ReplanSettings.of(motion.sidecar).command(str(spec_path), new)}\n  "
+          f"play-trajectory -n {new} -i", file=sys.stderr, flush=True)
+    return 1
 
 
 def _fill_ref_sample(sample, tick, player, latest, motors, default_battery_v: float) -> None:

@@ -24,7 +24,7 @@ import os
 import sys
 from pathlib import Path
 
-from execute.motion.config import MotionConfig
+from execute.motion.config import MotionConfig, add_motion_arguments, motion_config_from_args
 from robot.errors import InputError, run_cli
 from robot.vocabulary import FailureCause
 
@@ -47,22 +47,7 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--open-loop", action="store_true",
                    help="play the file as hubo-read-trajectory did, without the motion layer "
                         "(default: closed loop on the sensed state)")
-    cfg = MotionConfig()
-    p.add_argument("--max-reach-correction", type=float, default=cfg.max_reach_correction_m,
-                   metavar="M", help="closed loop: largest shift of a hold target [m], within "
-                                     f"[0, 0.10] (default {cfg.max_reach_correction_m})")
-    p.add_argument("--grasp-retries", type=int, default=cfg.grasp_retries, metavar="N",
-                   help="closed loop: re-reaches of a hand that closed on nothing, within "
-                        f"[0, 8] (default {cfg.grasp_retries})")
-    p.add_argument("--holding-arm-stiffness", type=float, default=cfg.holding_arm_stiffness,
-                   metavar="S", help="closed loop: share of the PWM stiffness pulling a "
-                                     "gripping arm towards the plan, within [0, 1] (default "
-                                     f"{cfg.holding_arm_stiffness})")
-    p.add_argument("--replan-beyond", type=float, default=cfg.replan_beyond_m, metavar="M",
-                   help="closed loop: when the first two grasps find the plan's holds further "
-                        "than M from the real ones, open the hands, retrace the plan, plan "
-                        "again for the ladder where the hands found it and climb that plan; "
-                        f"within [0, 0.2], 0 never (default {cfg.replan_beyond_m:g})")
+    add_motion_arguments(p)
     p.add_argument("--json", metavar="R.json", help="write the result here")
     p.add_argument("--video", metavar="V.mp4", help="write an MP4 (needs EGL)")
     p.add_argument("--plots", metavar="DIR", help="write tracking plots and a snapshot strip")
@@ -83,14 +68,6 @@ def ladder_from_sidecar(d: dict, where: str):
     from ladders.loader import ladder_from_mapping
 
     return ladder_from_mapping(d, where)
-
-
-def motion_config(args: argparse.Namespace):
-    """The motion layer's settings from the flags (refused outside their ranges)."""
-    return MotionConfig(max_reach_correction_m=args.max_reach_correction,
-                        grasp_retries=args.grasp_retries,
-                        holding_arm_stiffness=args.holding_arm_stiffness,
-                        replan_beyond_m=args.replan_beyond)
 
 
 def motion_summary(report: dict) -> str:
@@ -251,7 +228,7 @@ def _run(args: argparse.Namespace) -> int:
     opts = SimulationOptions(strategy=args.strategy,
                              placement=PlacementError.parse(args.placement_error),
                              board=board_cfg, closed_loop=not args.open_loop,
-                             motion=motion_config(args))
+                             motion=motion_config_from_args(args))
     with ProgressReporter("validate-plan", "simulated s", len(traj) / sidecar.rate_hz,
                           show=lambda done, total: f"{done:.1f}/{total:.1f}") as progress:
         run = simulate(traj, sidecar, ladder, opts, robot,

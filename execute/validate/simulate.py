@@ -277,32 +277,20 @@ def simulate(trajectory_rad: np.ndarray, sidecar: PlanSidecar, ladder: LadderSpe
                          trajectory_rad, ladder)
 
 
-#: How long the hands take to open before they retrace the plan, after the first touch [s].
-RETRACT_OPEN_S = 1.0
-
-
 def _retract(board: BoardModel, controller: JointController, gains: PwmGains,
              opt: SimulationOptions, trajectory_rad: np.ndarray, sidecar: PlanSidecar,
              line_index: int, held_ref_rad: np.ndarray) -> tuple[Failure | None, int]:
-    """After a ``ladder_misplaced`` stop: the hands open where they hold
-    (``held_ref_rad``, the motion layer's last reference, its corrections included),
-    their corrections fade out, and they retrace the plan from line ``line_index`` back
-    to its first, in position mode, the weight still on the floor (module docstring).
+    """After a ``ladder_misplaced`` stop: `execute.motion.retract.retract_lines` from line
+    ``line_index`` and the layer's last reference ``held_ref_rad``, in position mode, the
+    weight still on the floor (module docstring).
 
     Returns:
         A failure on the way (None if none) and the line index it ended on (0).
     """
-    from robot.joints import FINGER_JOINTS, joint_indices
+    from execute.motion.retract import retract_lines
 
     rate = int(round(sidecar.rate_hz))
-    back = np.array(trajectory_rad[line_index::-1], dtype=float)
-    held = np.array(held_ref_rad, dtype=float)
-    for side in ("left", "right"):
-        back[:, joint_indices(FINGER_JOINTS[side])] = 0.0
-        held[joint_indices(FINGER_JOINTS[side])] = 0.0
-    n = int(RETRACT_OPEN_S * rate)
-    fade = held + np.linspace(0.0, 1.0, n)[:, None] * (back[0] - held)
-    lines = np.vstack([np.repeat(held[None], n, axis=0), fade, back])
+    lines = retract_lines(trajectory_rad, line_index, held_ref_rad, rate)
     retract = TrajectoryPlayer(lines, PlayerOptions(rate_hz=rate),
                                ArmModeSchedule.all_position(len(lines)))
     monitor = VerdictMonitor(board, sidecar, np.eye(4), opt.verdict)
@@ -328,6 +316,7 @@ def _replan_after_touch(robot: str, sidecar: PlanSidecar, ladder: LadderSpec, mo
     import tempfile
     from pathlib import Path
 
+    from execute.motion.replan import ReplanSettings
     from planner.output import write_plan
     from planner.search import ClimbPlanner, PlannerConfig, PlanningFailed
     from planner.timing import TimingError
@@ -336,17 +325,13 @@ def _replan_after_touch(robot: str, sidecar: PlanSidecar, ladder: LadderSpec, mo
 
     stop = motion.stop
     placed = motion.measured_ladder
-    metrics = sidecar.metrics or {}
-    config = PlannerConfig(**{k: metrics[k] for k in (
-        "arm_strategy", "position_torque_share", "foot_cop_margin_m", "foot_friction_share")
-        if k in metrics})
-    top = max(h.hold_target.rung for limb, h in sidecar.final_holds.items()
-              if Limb(limb).is_foot and h.hold_target.kind is HoldTargetKind.RUNG)
+    settings = ReplanSettings.of(sidecar)
+    config = PlannerConfig(**settings.planner)
     t0 = time.perf_counter()
     new_plan, no_plan = None, None
     try:
-        planner = ClimbPlanner(placed, robot=robot, config=config, seed=sidecar.seed)
-        result = planner.plan(top_rung=top)
+        planner = ClimbPlanner(placed, robot=robot, config=config, seed=settings.seed)
+        result = planner.plan(top_rung=settings.top_rung)
         with tempfile.TemporaryDirectory() as tmp:
             out = Path(tmp) / "replanned.traj"
             write_plan(result, planner, out, sidecar.rate_hz, {"search_s": result.total_s})
