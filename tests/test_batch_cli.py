@@ -211,3 +211,35 @@ def test_real_plan_and_validate_on_the_stair_first_rung(tmp_path, capsys):
             # and where the run ended against the plan's own account of that line
             assert r["result"]["plan_vs_sim"]["line"] == r["result"]["line"]
     assert "stair" in text and "mixed" in text
+
+
+def test_the_summary_counts_re_plans_their_outcomes_and_planning_time(tmp_path):
+    """Closed runs that could plan again get a table of their own: how many did, how
+    many found no new plan, how many of the re-planned climbed, and the planning time."""
+    from execute.batch.report import summarize_records, write_markdown
+
+    def run(seed: int, outcome: str, replan: dict | None) -> dict:
+        return {"kind": "validate", "ladder": "drc", "seed": seed, "strategy": "mixed",
+                "loop": "closed", "replan_beyond_m": 0.02, "status": "ok",
+                "outcome": outcome, "cause": None if outcome == "climbed" else "board_trip",
+                "result": {"replan": replan}}
+
+    records = [run(1, "climbed", {"planning_s": 150.0, "no_plan": None}),
+               run(2, "failed", {"planning_s": 210.0, "no_plan": None}),
+               run(3, "failed", {"planning_s": 30.0, "no_plan": "placeHands: no sample"}),
+               run(4, "climbed", None)]
+    label = "mixed closed, re-plan > 2 cm"
+    summary = summarize_records(records, {"drc": load_ladder("drc")}, [label],
+                                {("drc", label): 4}, {"drc": 0})
+    (row,) = summary.replans
+    assert (row.runs, row.replanned, row.no_plan, row.climbed) == (4, 3, 1, 1)
+    assert (row.planning_s.min, row.planning_s.median) == (30.0, 150.0)
+    md = write_markdown(summary, tmp_path / "s.md").read_text()
+    assert "## Re-plans after the first touch" in md
+    assert f"| drc | {label} | 4 | 3 | 1 | 1 | 30 / 150 /" in md
+    without = summarize_records([{k: v for k, v in r.items() if k != "replan_beyond_m"}
+                                 for r in records],
+                                {"drc": load_ladder("drc")}, ["mixed closed"],
+                                {("drc", "mixed closed"): 4}, {"drc": 0})
+    assert not without.replans
+    assert "Re-plans" not in write_markdown(without, tmp_path / "w.md").read_text()

@@ -28,7 +28,7 @@ from execute.batch.jobs import record_label
 from execute.batch.stats import Distribution, SuccessRate, summarize
 from ladders.spec import LadderSpec
 
-__all__ = ["PlanRow", "Summary", "SummaryRow", "print_summary", "summarize_records",
+__all__ = ["PlanRow", "ReplanRow", "Summary", "SummaryRow", "print_summary", "summarize_records",
            "write_csv", "write_markdown"]
 
 
@@ -71,11 +71,27 @@ class PlanRow:
     no_plan: dict[str, int]
 
 
+@dataclass(frozen=True)
+class ReplanRow:
+    """Re-plans after the first touch, per ladder × run label (closed runs with
+    ``--replan-beyond``): how many runs planned again, how many of those found a plan and
+    climbed, and the re-plan's planning time [s]."""
+
+    ladder: str
+    strategy: str
+    runs: int
+    replanned: int
+    no_plan: int
+    climbed: int
+    planning_s: Distribution
+
+
 @dataclass
 class Summary:
     rows: list[SummaryRow]
     plans: list[PlanRow]
     sweep_fields: list[str] = field(default_factory=list)
+    replans: list[ReplanRow] = field(default_factory=list)
 
     def causes(self) -> Counter:
         """Failure causes over every row."""
@@ -138,7 +154,34 @@ def summarize_records(records: Iterable[dict], ladders: Mapping[str, LadderSpec]
                             summarize(r.get("plan_s") for r in found),
                             dict(why.most_common())))
     fields_ = sorted({k for sw in sweeps.values() for k in sw})
-    return Summary(rows, prow, fields_)
+    return Summary(rows, prow, fields_, _replan_rows(val))
+
+
+def _replan_rows(val: Mapping[tuple[str, str], list[dict]]) -> list[ReplanRow]:
+    """A row per ladder × label whose runs could plan again (`ReplanRow`)."""
+    out = []
+    for (key, label), recs in val.items():
+        ok = [r for r in recs if r.get("status") == "ok" and r.get("replan_beyond_m")]
+        if not ok:
+            continue
+        done = [r for r in ok if (r.get("result") or {}).get("replan")]
+        none = [r for r in done if r["result"]["replan"].get("no_plan")]
+        out.append(ReplanRow(key, label, len(ok), len(done), len(none),
+                             sum(r.get("outcome") == "climbed" for r in done),
+                             summarize(r["result"]["replan"].get("planning_s") for r in done)))
+    return out
+
+
+def _replan_table(summary: Summary) -> tuple[list[str], list[list[str]]]:
+    head = ["ladder", "strategy", "runs", "re-planned", "no new plan", "climbed after it",
+            "planning [s] min/med/p90"]
+    body = []
+    for r in summary.replans:
+        d = r.planning_s
+        dist = "–" if not d.n else f"{d.min:.0f} / {d.median:.0f} / {d.p90:.0f}"
+        body.append([r.ladder, r.strategy, str(r.runs), str(r.replanned), str(r.no_plan),
+                     str(r.climbed), dist])
+    return head, body
 
 
 def _pct(x: float) -> str:
@@ -194,17 +237,27 @@ def print_summary(summary: Summary, console) -> None:
     for row in body:
         t.add_row(*row)
     console.print(t)
-    head, body = _plan_rows(summary)
-    t = Table(title="planning per ladder")
-    for h in head:
-        t.add_column(escape(h), overflow="fold")
-    for row in body:
-        t.add_row(*(escape(c) for c in row))
-    console.print(t)
+    console.print(_plain_table("planning per ladder", *_plan_rows(summary)))
+    if summary.replans:
+        console.print(_plain_table("re-plans after the first touch",
+                                   *_replan_table(summary)))
     causes = summary.causes()
     if causes:
         console.print("failure causes: " + _causes(dict(causes.most_common())), highlight=False,
                       markup=False)
+
+
+def _plain_table(title: str, head: list[str], body: list[list[str]]):
+    """A rich table of text cells, printed verbatim."""
+    from rich.markup import escape
+    from rich.table import Table
+
+    t = Table(title=title)
+    for h in head:
+        t.add_column(escape(h), overflow="fold")
+    for row in body:
+        t.add_row(*(escape(c) for c in row))
+    return t
 
 
 def write_csv(summary: Summary, path: str | Path) -> Path:
@@ -239,7 +292,11 @@ def write_markdown(summary: Summary, path: str | Path, title: str = "batch-eval"
     """The tables as Markdown (success, planning, failure causes)."""
     parts = [f"# {title}", "", "## Success rate per ladder × strategy (95 % Wilson interval)",
              "", _md_table(*_table_rows(summary)), "", "## Planning per ladder", "",
-             _md_table(*_plan_rows(summary)), "", "## Failure causes", ""]
+             _md_table(*_plan_rows(summary)), ""]
+    if summary.replans:
+        parts += ["## Re-plans after the first touch", "", _md_table(*_replan_table(summary)),
+                  ""]
+    parts += ["## Failure causes", ""]
     causes = summary.causes()
     parts.append(_md_table(["cause", "count"], [[k, str(v)] for k, v in causes.most_common()])
                  if causes else "none")
