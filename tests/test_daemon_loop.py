@@ -199,14 +199,16 @@ def test_neck_channel_overrides_the_neck():
 
 
 def test_unhomed_joints_do_not_move_until_homed_and_the_gate_ends():
-    be = FakeBackend(homed=False)
-    loop, w = _loop(be, home_ignore_s=0.1)
+    # the loop's own clock (5 ms a tick), so that the gate ends on a tick whatever the
+    # host's load: in wall time a loaded host once spent the 0.1 s within 20 ticks
+    be = FakeBackend(homed=False, clock=FakeClock())
+    loop, w = _loop(be, home_ignore_s=0.3)
     w.ref.write(_ref(-0.2, playing=0))
     loop.run(max_ticks=30)
     assert np.all(be.sent[-1].ref_rad == 0.0)
     assert np.all(loop.state["status"] & int(StatusFlag.NOT_HOMED))
     w.board_cmd.write(_cmd(BoardCommandType.HOME, RSP))
-    loop.run(max_ticks=50)  # within the 0.1 s gate
+    loop.run(max_ticks=50)  # 20 ticks (0.1 s) into the 0.3 s gate
     assert be.commands == [(BoardCommandType.HOME, RSP)]
     assert loop.zeroed[RSP] and loop.zeroed.sum() == 1
     assert be.sent[-1].ref_rad[RSP] == 0.0
