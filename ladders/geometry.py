@@ -29,6 +29,11 @@ def rot_z(angle_rad: float) -> np.ndarray:
     return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
+def wrap_rad(angle_rad: float) -> float:
+    """``angle_rad`` wrapped into (−π, π]."""
+    return math.atan2(math.sin(angle_rad), math.cos(angle_rad))
+
+
 def _rot_y(angle_rad: float) -> np.ndarray:
     c, s = math.cos(angle_rad), math.sin(angle_rad)
     return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
@@ -360,4 +365,5 @@ def ladder_geometry(spec: LadderSpec) -> LadderGeometry:
     return LadderGeometry(spec)
 
 
-__all__ = ["SIDES", "LadderGeometry", "Solid", "ladder_geometry", "make_transform", "rot_z"]
+__all__ = ["SIDES", "LadderGeometry", "Solid", "ladder_geometry", "make_transform", "rot_z",
+           "wrap_rad"]

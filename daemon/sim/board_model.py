@@ -54,6 +54,7 @@ from daemon.joint_control import ControlOutput
 from daemon.sim.board_trip import BOARDS, BoardTripConfig, BoardTripMonitor, TripEvent
 from daemon.sim.grasp_latch import GraspEvent, GraspLatch, GripConfig
 from daemon.sim.sensors import SensorIndex, SensorReading, add_sensors, read_sensors
+from ladders.geometry import wrap_rad
 from ladders.scene import build_scene
 from ladders.spec import LadderSpec
 from robot.constants import TICK_S
@@ -96,18 +97,16 @@ class PlacementError:
     @classmethod
     def between(cls, planned: LadderSpec, real: LadderSpec) -> PlacementError:
         """The error that `apply` turns ``planned`` into ``real`` with."""
-        yaw = real.placement_yaw_rad - planned.placement_yaw_rad
         return cls(real.placement_x_m - planned.placement_x_m,
                    real.placement_y_m - planned.placement_y_m,
-                   math.atan2(math.sin(yaw), math.cos(yaw)))
+                   wrap_rad(real.placement_yaw_rad - planned.placement_yaw_rad))
 
     def apply(self, ladder: LadderSpec) -> LadderSpec:
         """The ladder as it really stands."""
-        yaw = ladder.placement_yaw_rad + self.dyaw_rad
-        yaw = math.atan2(math.sin(yaw), math.cos(yaw))
         return dataclasses.replace(ladder, placement_x_m=ladder.placement_x_m + self.dx_m,
                                    placement_y_m=ladder.placement_y_m + self.dy_m,
-                                   placement_yaw_rad=yaw)
+                                   placement_yaw_rad=wrap_rad(ladder.placement_yaw_rad
+                                                              + self.dyaw_rad))
 
     def __bool__(self) -> bool:
         return any((self.dx_m, self.dy_m, self.dyaw_rad))

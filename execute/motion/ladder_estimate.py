@@ -23,12 +23,11 @@ tell the body's heading from their own lateral settling.
 from __future__ import annotations
 
 import dataclasses
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
-from ladders.geometry import rot_z
+from ladders.geometry import rot_z, wrap_rad
 from ladders.spec import LadderSpec
 
 __all__ = ["LadderEstimate", "RailObservation"]
@@ -109,7 +108,7 @@ class LadderEstimate:
             yaw -= stance_heading_rad
         return dataclasses.replace(spec, placement_x_m=float(at[0]),
                                    placement_y_m=float(at[1]),
-                                   placement_yaw_rad=math.atan2(math.sin(yaw), math.cos(yaw)))
+                                   placement_yaw_rad=wrap_rad(yaw))
 
     def last_held_m(self, rail: str) -> np.ndarray | None:
         """Where a hand last held ``rail``: its measured palm in the world [m]; None if

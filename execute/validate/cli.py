@@ -24,7 +24,7 @@ import os
 import sys
 from pathlib import Path
 
-from execute.motion.config import MotionConfig, add_motion_arguments, motion_config_from_args
+from execute.motion.config import add_motion_arguments, motion_config_from_args
 from robot.errors import InputError, run_cli
 from robot.vocabulary import FailureCause
 
@@ -177,8 +177,8 @@ def result_json(run, metrics, plan_path: str, comparison=None) -> dict:
         "metrics": metrics.to_json(),
         "plan_vs_sim": None if comparison is None else comparison.to_json(),
         "motion": run.motion,
-        "replan_beyond_m": ((run.options.motion or MotionConfig()).replan_beyond_m
-                            if run.options.closed_loop else None),
+        "replan_beyond_m": (run.options.motion.replan_beyond_m if run.options.closed_loop
+                            else None),
         "replan": run.replan,
     }
 

@@ -38,6 +38,7 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -56,6 +57,9 @@ from ladders.spec import LadderSpec
 from robot.errors import InputError
 from robot.plan_sidecar import PlanSidecar
 from robot.vocabulary import ArmStrategy, FailureCause, HoldTargetKind, Limb
+
+if TYPE_CHECKING:  # pinocchio: imported only when the loop is closed
+    from execute.motion.layer import MotionLayer
 
 __all__ = ["STRATEGIES", "SimulationLog", "SimulationOptions", "SimulationRun", "simulate"]
 
@@ -80,7 +84,7 @@ class SimulationOptions:
         closed_loop: play through the motion layer (`execute.motion`), on the state
             struct the daemon publishes; False plays the file open loop, as
             hubo-read-trajectory did.
-        motion: the motion layer's tunables (`execute.motion.MotionConfig` when None).
+        motion: the motion layer's tunables.
     """
 
     strategy: str = "mixed"
@@ -91,7 +95,7 @@ class SimulationOptions:
     stop_on_failure: bool = True
     record_qpos: bool = True
     closed_loop: bool = True
-    motion: MotionConfig | None = None
+    motion: MotionConfig = field(default_factory=MotionConfig)
 
     def __post_init__(self) -> None:
         if self.strategy not in STRATEGIES:
@@ -219,24 +223,12 @@ def simulate(trajectory_rad: np.ndarray, sidecar: PlanSidecar, ladder: LadderSpe
     joints in PWM mode.
     """
     opt = options or SimulationOptions()
-    n = len(trajectory_rad)
     board, T_err = _placed_board(trajectory_rad[0], sidecar, ladder, opt, robot)
-    schedule, compliant = _schedule(opt.strategy, sidecar, n)
     rate = int(round(sidecar.rate_hz))
-    player = TrajectoryPlayer(trajectory_rad, PlayerOptions(rate_hz=rate,
-                                                            compliant_arms=compliant),
-                              schedule, sidecar.arm_feedforward)
     controller = JointController(robot=robot)
-
-    monitor = VerdictMonitor(board, sidecar, T_err, opt.verdict)
-    motion = None
-    if opt.closed_loop:
-        from execute.motion.layer import MotionLayer  # pinocchio: only when closing the loop
-
-        motion = MotionLayer(player, trajectory_rad, sidecar, ladder, robot, opt.motion)
+    player, motion, monitor, rec = _playback(trajectory_rad, sidecar, ladder, opt, board,
+                                             robot, T_err)
     gains = opt.gains or (default_drc_gains() if motion is None else motion.pwm_gains)
-    rec = _Recorder(int(math.ceil((player.duration_s + opt.verdict.settle_s) / TICK_S)),
-                    board.model.nq if opt.record_qpos else 0)
     wall0 = time.perf_counter()
     failure, line_index = _run_ticks(board, player, motion, controller, monitor, gains, rec,
                                      opt, progress)
@@ -252,21 +244,12 @@ def simulate(trajectory_rad: np.ndarray, sidecar: PlanSidecar, ladder: LadderSpe
         if new_plan is not None:
             trajectory_rad, sidecar, ladder = new_plan
             replan["placement_error_before"] = dataclasses.asdict(opt.placement)
-            opt = dataclasses.replace(opt, placement=PlacementError.between(ladder, real_ladder))
-            schedule, compliant = _schedule(opt.strategy, sidecar, len(trajectory_rad))
-            player = TrajectoryPlayer(trajectory_rad,
-                                      PlayerOptions(rate_hz=rate, compliant_arms=compliant,
-                                                    go_to_init=True),
-                                      schedule, sidecar.arm_feedforward)
             # one re-plan: the new plan's own small misplacement is corrected reach by reach
-            motion = MotionLayer(player, trajectory_rad, sidecar, ladder, robot,
-                                 dataclasses.replace(opt.motion or MotionConfig(),
-                                                     replan_beyond_m=0.0))
-            monitor = VerdictMonitor(board, sidecar, _misplacement(ladder, opt.placement),
-                                     opt.verdict)
-            rec = _Recorder(int(math.ceil((player.duration_s + opt.verdict.settle_s)
-                                          / TICK_S)),
-                            board.model.nq if opt.record_qpos else 0)
+            opt = dataclasses.replace(opt, placement=PlacementError.between(ladder, real_ladder),
+                                      motion=dataclasses.replace(opt.motion, replan_beyond_m=0.0))
+            player, motion, monitor, rec = _playback(
+                trajectory_rad, sidecar, ladder, opt, board, robot,
+                _misplacement(ladder, opt.placement), go_to_init=True)
             failure, line_index = _run_ticks(board, player, motion, controller, monitor,
                                              gains, rec, opt, progress, t0_s=board.time_s)
     wall = time.perf_counter() - wall0
@@ -275,6 +258,29 @@ def simulate(trajectory_rad: np.ndarray, sidecar: PlanSidecar, ladder: LadderSpe
     return SimulationRun(verdict, sim_log, board, sidecar, opt, wall, board.time_s, rate,
                          None if motion is None else motion.report(), replan,
                          trajectory_rad, ladder)
+
+
+def _playback(trajectory_rad: np.ndarray, sidecar: PlanSidecar, ladder: LadderSpec,
+              opt: SimulationOptions, board: BoardModel, robot: str, T_err: np.ndarray,
+              go_to_init: bool = False
+              ) -> tuple[TrajectoryPlayer, MotionLayer | None, VerdictMonitor, _Recorder]:
+    """What plays a plan on ``board``: its player (``go_to_init``: from where the robot
+    stands), the motion layer when the loop is closed (else None), the verdict monitor
+    (T_err: the planned ladder to the real one) and the recorder."""
+    schedule, compliant = _schedule(opt.strategy, sidecar, len(trajectory_rad))
+    player = TrajectoryPlayer(trajectory_rad,
+                              PlayerOptions(rate_hz=int(round(sidecar.rate_hz)),
+                                            compliant_arms=compliant, go_to_init=go_to_init),
+                              schedule, sidecar.arm_feedforward)
+    monitor = VerdictMonitor(board, sidecar, T_err, opt.verdict)
+    motion = None
+    if opt.closed_loop:
+        from execute.motion.layer import MotionLayer  # pinocchio: only when closing the loop
+
+        motion = MotionLayer(player, trajectory_rad, sidecar, ladder, robot, opt.motion)
+    rec = _Recorder(int(math.ceil((player.duration_s + opt.verdict.settle_s) / TICK_S)),
+                    board.model.nq if opt.record_qpos else 0)
+    return player, motion, monitor, rec
 
 
 def _retract(board: BoardModel, controller: JointController, gains: PwmGains,
