@@ -325,13 +325,72 @@ def test_once_off_the_floor_the_body_takes_the_ladders_placement(reach):
     assert np.allclose(layer._body_shift_m(hold), on_floor)
 
 
+def test_on_the_ladder_the_body_is_trimmed_back_to_the_held_rails(reach):
+    """Once the ladder alone carries the robot, the holding hands' encoders measure how
+    far the body stands across the rails from the plan's posture (a creeping foot, arms
+    pulling on their grips). Every holding limb, a stance foot with no correction of its
+    own included, then moves the body back, within the bound; an error the body has
+    already taken out leaves the trim where it is."""
+    from execute.motion.estimator import BodyEstimate
+    from execute.motion.events import MotionEventKind
+    from execute.motion.layer import MotionLayer
+    from execute.play.player import PlayerOptions, TrajectoryPlayer
+
+    _path, traj, sc, ladder = reach
+    seg = sc.segments[-1]
+    assert {"left_hand", "right_hand", "left_foot"} <= set(seg.holds)
+    layer = MotionLayer(TrajectoryPlayer(traj, PlayerOptions(rate_hz=int(sc.rate_hz))),
+                        traj, sc, ladder)
+    layer.estimate = BodyEstimate(0.0, np.eye(4), np.eye(3), {"left": True, "right": True},
+                                  {}, {}, {"left": 0.09, "right": 0.09})
+    layer._line = line = seg.first_line - 1
+    layer._body_on_ladder = True
+    layer._held_rails = {side: (f"rail_{side}", np.asarray(seg.holds[f"{side}_hand"].position_m))
+                         for side in ("left", "right")}
+    layer._follow_holds(seg)  # the holds as they are taken: nothing to realise yet
+    assert "left_foot" not in layer._offsets
+    rail_up = layer._rail_direction("rail_left")
+    across = np.eye(3) - np.outer(rail_up, rail_up)
+
+    def sensed_with_body_at(offset_m):
+        """The encoders with both hands on their holds and the body ``offset_m`` away."""
+        q = traj[line].copy()
+        for side in ("left", "right"):
+            q += layer._limb_shift_dq(f"{side}_hand", line, -offset_m, np.eye(3))[0]
+        return q
+
+    towards_ladder = -layer.geometry.rung_line_normal
+    body = 0.02 * towards_ladder  # pulled 2 cm towards the ladder
+    layer._pos_rad = sensed_with_body_at(body)
+    layer._trim_body()
+    assert np.allclose(layer._body_trim_m, -across @ body, atol=1.5e-3)
+    assert layer.events[-1].kind is MotionEventKind.BODY_TRIM
+    layer._follow_holds(seg)
+    end = seg.last_line - 1
+    frame = layer.model.chains["left_foot"].frame
+    moved = (layer.model.frame_in_pelvis(traj[end] + layer._offsets["left_foot"].end, frame)
+             - layer.model.frame_in_pelvis(traj[end], frame))[:3, 3]
+    # the foot pushes it back (horizontally: the fixture's standing leg is near straight,
+    # so the foot cannot also move down relative to the pelvis)
+    assert np.allclose(moved[:2], -layer._body_trim_m[:2], atol=1e-3)
+
+    trim = layer._body_trim_m.copy()
+    layer._pos_rad = traj[line].copy()  # the body back where the plan has it
+    layer._trim_body()
+    assert np.array_equal(layer._body_trim_m, trim)
+    layer._pos_rad = sensed_with_body_at(0.08 * towards_ladder)  # beyond the bound
+    layer._trim_body()
+    assert np.linalg.norm(layer._body_trim_m) == pytest.approx(layer.config.max_body_trim_m)
+
+
 @pytest.mark.parametrize("field,value", [("max_reach_correction_m", 0.2),
                                          ("grasp_retries", -1),
                                          ("max_reach_correction_rad", 1.0),
                                          ("landing_reach_m", 0.10),
                                          ("landing_load_n", 0.0),
                                          ("strike_load_n", 5.0),
-                                         ("strike_backoff_m", 0.08)])
+                                         ("strike_backoff_m", 0.08),
+                                         ("max_body_trim_m", 0.08)])
 def test_unsafe_settings_are_refused(field, value):
     with pytest.raises(MotionConfigError) as exc:
         MotionConfig(**{field: value})

@@ -68,6 +68,7 @@ _RANGES = {
     "strike_tries": (0, 4),
     "hand_strike_load_n": (5.0, 100.0),
     "replan_beyond_m": (0.0, 0.2),
+    "max_body_trim_m": (0.0, 0.05),
 }
 
 
@@ -120,6 +121,12 @@ class MotionConfig:
             plan's for the wrong ladder. ``validate-plan`` then re-plans for the measured
             placement and climbs that plan; on the robot the operator does. 0: never
             (each reach is corrected instead) [m].
+        max_body_trim_m: once the ladder alone carries the robot, the body is moved back
+            to the plan's posture relative to the rails its hands hold, as their arms'
+            encoders measure it, by at most this [m]; 0: never. A stance foot creeping on
+            its rung and compliant arms pulling on their grips move the body 2–3 cm
+            towards the ladder over a climb, where the plan keeps its shins 1–2.5 cm
+            clear of the rungs.
         estimator: the state estimator's thresholds.
     """
 
@@ -147,6 +154,7 @@ class MotionConfig:
     strike_tries: int = 2
     hand_strike_load_n: float = 15.0
     replan_beyond_m: float = 0.0
+    max_body_trim_m: float = 0.03
     estimator: EstimatorConfig = field(default_factory=EstimatorConfig)
 
     def __post_init__(self) -> None:
@@ -190,6 +198,11 @@ def add_motion_arguments(parser: argparse.ArgumentParser) -> None:
                              "hands found it and climbs that plan, play-trajectory writes "
                              "that ladder for plan-ladder; " + within("replan_beyond_m")
                              + ", 0 never")
+    parser.add_argument("--max-body-trim", type=float, default=cfg.max_body_trim_m,
+                        metavar="M",
+                        help="closed loop: largest move of the body back to the plan's "
+                             "posture relative to the rails its hands hold [m], "
+                             + within("max_body_trim_m") + ", 0 never")
 
 
 def motion_config_from_args(args: argparse.Namespace) -> MotionConfig:
@@ -201,4 +214,5 @@ def motion_config_from_args(args: argparse.Namespace) -> MotionConfig:
     return MotionConfig(max_reach_correction_m=args.max_reach_correction,
                         grasp_retries=args.grasp_retries,
                         holding_arm_stiffness=args.holding_arm_stiffness,
-                        replan_beyond_m=args.replan_beyond)
+                        replan_beyond_m=args.replan_beyond,
+                        max_body_trim_m=args.max_body_trim)

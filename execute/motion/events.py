@@ -21,6 +21,7 @@ class MotionEventKind(enum.Enum):
     STIFF_REACH = "stiff reach"  #: a compliant arm short of its hold finished in position mode
     LEG_RELIEF = "leg relief"  #: the gripping arms began to lift more: a leg joint neared its limit
     LADDER_ESTIMATE = "ladder estimate"  #: the estimate of the ladder's pose changed
+    BODY_TRIM = "body trim"  #: the body moved back to the plan's posture relative to the rails
     FOOT_LANDING = "foot landing"  #: a step ended with its foot unloaded; it reached further
     FOOT_STRIKE = "foot strike"  #: a swinging foot met something from above; it backed off
     HAND_STRIKE = "hand strike"  #: a reaching hand was pushed by the ladder; it backed off

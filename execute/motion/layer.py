@@ -60,7 +60,12 @@ hubo-motion-rt and the thesis's operator did (thesis §4.3.4, §6.2):
   its hold (from its references as it starts to hold), realised again at each segment's pose
   (`_follow_holds`). While a foot stands on the floor the body keeps the plan's posture
   over the floor; once none does, the body takes the ladder's placement and the holds on
-  the ladder need no correction of their own (`_body_shift_m`).
+  the ladder need no correction of their own (`_body_shift_m`);
+- **the body trimmed to the rails**: once the ladder alone carries the robot, at every
+  segment the hands that hold verified grasps measure, by their arms' encoders, how far
+  the body stands across the rails from the plan's posture relative to them (a creeping
+  stance foot, compliant arms pulling on their grips); every holding limb's references
+  then move the body back, within ``max_body_trim_m`` (`_trim_body`).
 
 Its only input is the daemon's state struct (`execute.motion.sensed_state`). It writes
 references, modes and feed-forward, the same things the open-loop player writes.
@@ -122,6 +127,9 @@ APEX_STRIDE_LINES = 20
 STRIKE_DOWN_SHARE = 1.0 / 3.0
 #: Two targets closer than this are the same [m].
 SAME_TARGET_M = 0.005
+#: A body error across the rails smaller than this does not move the body [m]: a grip
+#: holds its rail anywhere within a few millimetres of the palm's planned point.
+BODY_TRIM_DEADBAND_M = 0.005
 #: A stiff arm whose motor currents say a joint has pushed harder than this share of its
 #: torque limit for `STIFF_ARM_YIELD_S` complies again: its open hand pushes on the rail
 #: or a rung (a stiff re-reach on `stair` tripped a shoulder's board so, 2026-11-27; a
@@ -252,6 +260,9 @@ class MotionLayer:
         #: no foot of this segment stands on the floor: the body takes the ladder's
         #: placement (`_body_shift_m`)
         self._body_on_ladder = False
+        #: where the body is moved, on top of the ladder's placement, to stand in the
+        #: plan's posture relative to the held rails, world [m] (`_trim_body`)
+        self._body_trim_m = np.zeros(3)
         self._arrived: set[tuple[int, str]] = set()
         #: side → (first compliant line, grasp's first line, grasp segment) of each reach
         #: whose arm the schedule turns compliant in the air before its grasp, 0-based
@@ -407,10 +418,11 @@ class MotionLayer:
         """How far the body's own placement moves a hold planned at ``planned_m`` [m]:
         nothing while a foot stands on the floor (the plan's posture over the floor
         feet); once the ladder alone carries the robot, the ladder estimate's shift
-        there, so that the body keeps the plan's posture relative to the ladder."""
+        there, so that the body keeps the plan's posture relative to the ladder, plus the
+        trim that takes it back there (`_trim_body`)."""
         if not self._body_on_ladder:
             return np.zeros(3)
-        return self._bounded(self.ladder.correction_m(planned_m))
+        return self._bounded(self.ladder.correction_m(planned_m)) + self._body_trim_m
 
     def _body_yaw_rad(self) -> float:
         """The yaw of the body's own placement (`_body_shift_m`) [rad]."""
@@ -464,6 +476,51 @@ class MotionLayer:
                 R_wp @ Rotation.from_rotvec(turn).as_matrix() @ R_wp.T
                 @ rot_z(self._body_yaw_rad()))
 
+    def _body_error_m(self) -> np.ndarray | None:
+        """How far the body stands from the plan's posture relative to the rails that the
+        hands hold (verified grasps, `_held_rails`), across the rails, world frame [m]:
+        the plan's palm against the encoders' palm, both in the pelvis frame, averaged
+        over the holding hands. A verified hand is on its rail, where the plan has the
+        hold once the ladder's placement is taken (the body's target is the same
+        placement), so no odometry enters; None without a held rail."""
+        R_wp = self.estimate.T_world_pelvis[:3, :3]
+        errors = []
+        for side, (rail, _planned_m) in sorted(self._held_rails.items()):
+            frame = f"{side[0].upper()}_palm"
+            planned = self.model.frame_in_pelvis(self.trajectory_rad[self._line], frame)[:3, 3]
+            sensed = self.model.frame_in_pelvis(self._pos_rad, frame)[:3, 3]
+            error = R_wp @ (planned - sensed)
+            axis = self._rail_direction(rail)
+            errors.append(error - (error @ axis) * axis)
+        return np.mean(errors, axis=0) if errors else None
+
+    def _trim_body(self) -> None:
+        """Once the ladder alone carries the robot, move the body back to the plan's
+        posture relative to the held rails (`_body_error_m`): the trim integrates the
+        error, within ``max_body_trim_m``, and every holding limb realises it over the
+        segment (`_follow_holds`). A stance foot that creeps on its rung carries the body
+        with it (2–3 cm over a DRC climb), and compliant arms that pull on their grips
+        draw it towards the ladder (2.1 cm on `ship`, where the plan keeps a shin 2 cm
+        clear of its rung): leg odometry sees neither, the arms' encoders both."""
+        cap = self.config.max_body_trim_m
+        if not self._body_on_ladder or cap <= 0.0:
+            self._body_trim_m = np.zeros(3)
+            return
+        error = self._body_error_m()
+        if error is None or float(np.linalg.norm(error)) < BODY_TRIM_DEADBAND_M:
+            return
+        trim = self._body_trim_m - error
+        length = float(np.linalg.norm(trim))
+        if length > cap:
+            trim *= cap / length
+        self._event(MotionEventKind.BODY_TRIM, "",
+                    float(np.linalg.norm(trim - self._body_trim_m)),
+                    f"the holding hands put the body {np.round(error * 100, 1).tolist()} cm "
+                    "across the rails from the plan's posture; its placement moves by "
+                    f"{np.round((trim - self._body_trim_m) * 100, 1).tolist()} cm (trim "
+                    f"{np.round(trim * 100, 1).tolist()} cm)")
+        self._body_trim_m = trim
+
     def _follow_holds(self, seg: Segment) -> None:
         """Keep every holding limb's correction where it holds at this segment's poses.
 
@@ -480,25 +537,28 @@ class MotionLayer:
         for limb, hold in seg.holds.items():
             planned_m = np.asarray(hold.position_m)
             if limb not in self._hold_corrections:
-                if limb not in self._offsets:
-                    continue
                 q_held = self.trajectory_rad[self._line] + self._offset(limb)
                 self._hold_corrections[limb] = self._correction_at(limb, q_held, planned_m)
             shift_world_m, turn_world = self._hold_corrections[limb]
-            dq, _residual = self._limb_shift_dq(
-                limb, seg.last_line - 1, shift_world_m - self._body_shift_m(planned_m),
-                turn_world @ rot_z(self._body_yaw_rad()).T)
+            shift_m = shift_world_m - self._body_shift_m(planned_m)
+            turn = turn_world @ rot_z(self._body_yaw_rad()).T
+            if limb not in self._offsets and float(np.linalg.norm(shift_m)) < 1e-6 \
+                    and np.allclose(turn, np.eye(3), atol=1e-9):
+                continue  # held where the plan has it relative to the body
+            dq, _residual = self._limb_shift_dq(limb, seg.last_line - 1, shift_m, turn)
             self._offsets[limb] = _Blend(self._offset(limb), dq, float(seg.first_line - 1),
                                          float(seg.last_line - 1))
 
     def _enter_segment(self, k: int) -> None:
         """Measure the held rails again; keep the holding limbs where they hold (the body
-        on the ladder's placement once no foot stands on the floor); re-target the
-        reaches of segment ``k`` from the ladder estimate."""
+        on the ladder's placement once no foot stands on the floor, trimmed back to the
+        plan's posture relative to the held rails); re-target the reaches of segment
+        ``k`` from the ladder estimate."""
         seg = self.sidecar.segments[k]
         self._observe_held_rails(seg)
         self._body_on_ladder = not any(limb.endswith("_foot") and h.target == "floor"
                                        for limb, h in seg.holds.items())
+        self._trim_body()
         self._follow_holds(seg)
         for limb, (_j, hold) in self._next_hold[k].items():
             if seg.phase != "limb" or not self._on_ladder(hold.target):
@@ -1140,10 +1200,12 @@ class MotionLayer:
                        "holding_arm_stiffness": self.config.holding_arm_stiffness,
                        "arm_max_pwm_pct": float(self.pwm_gains.max_pwm_pct.max()),
                        "max_reach_correction_m": self.config.max_reach_correction_m,
+                       "max_body_trim_m": self.config.max_body_trim_m,
                        "grasp_retries": self.config.grasp_retries},
             "counts": counts,
             "ladder_shift_m": [round(float(v), 4) for v in self.ladder.shift_m],
             "ladder_yaw_rad": round(self.ladder.yaw_rad, 4),
+            "body_trim_m": [round(float(v), 4) for v in self._body_trim_m],
             "leg_relief_peak_n": round(self.leg_relief.peak_lift_n, 1),
             "leg_relief_joint": self.leg_relief.peak_joint,
             "stop": None if self.stop is None else dataclasses.asdict(self.stop),
