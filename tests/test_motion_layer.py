@@ -347,16 +347,19 @@ def test_on_the_ladder_the_body_is_trimmed_back_to_the_held_rails(reach):
     layer._body_on_ladder = True
     layer._held_rails = {side: (f"rail_{side}", np.asarray(seg.holds[f"{side}_hand"].position_m))
                          for side in ("left", "right")}
+    for side in ("left", "right"):  # grasps made from the floor
+        layer._seat_grasp(side, f"rail_{side}", on_floor=True)
     layer._follow_holds(seg)  # the holds as they are taken: nothing to realise yet
     assert "left_foot" not in layer._offsets
     rail_up = layer._rail_direction("rail_left")
     across = np.eye(3) - np.outer(rail_up, rail_up)
 
-    def sensed_with_body_at(offset_m):
-        """The encoders with both hands on their holds and the body ``offset_m`` away."""
+    def sensed_with_body_at(offset_m, left_seat_m=np.zeros(3)):
+        """The encoders with both hands on their holds (the left one seated
+        ``left_seat_m`` from it) and the body ``offset_m`` away."""
         q = traj[line].copy()
-        for side in ("left", "right"):
-            q += layer._limb_shift_dq(f"{side}_hand", line, -offset_m, np.eye(3))[0]
+        for side, seat in (("left", left_seat_m), ("right", np.zeros(3))):
+            q += layer._limb_shift_dq(f"{side}_hand", line, seat - offset_m, np.eye(3))[0]
         return q
 
     towards_ladder = -layer.geometry.rung_line_normal
@@ -378,6 +381,15 @@ def test_on_the_ladder_the_body_is_trimmed_back_to_the_held_rails(reach):
     layer._pos_rad = traj[line].copy()  # the body back where the plan has it
     layer._trim_body()
     assert np.array_equal(layer._body_trim_m, trim)
+    # the left hand grasps again on the ladder, seated 1.5 cm off its hold, while the
+    # body stands 1 cm from the plan's posture: the body error stays the right hand's
+    seat = np.array([0.0, 0.015, 0.0])
+    body = 0.01 * towards_ladder
+    layer._pos_rad = sensed_with_body_at(body, seat)
+    layer._seat_grasp("left", "rail_left", on_floor=False)
+    assert np.allclose(layer._body_error_m(), across @ body, atol=1e-3)
+    assert np.allclose(layer._hand_body_error_m("left", "rail_left"), across @ (body - seat),
+                       atol=1e-3)
     layer._pos_rad = sensed_with_body_at(0.08 * towards_ladder)  # beyond the bound
     layer._trim_body()
     assert np.linalg.norm(layer._body_trim_m) == pytest.approx(layer.config.max_body_trim_m)

@@ -263,6 +263,9 @@ class MotionLayer:
         #: where the body is moved, on top of the ladder's placement, to stand in the
         #: plan's posture relative to the held rails, world [m] (`_trim_body`)
         self._body_trim_m = np.zeros(3)
+        #: side → what its grasp's own seat adds to the body error it reads [m]
+        #: (`_hand_body_error_m`, `_seat_grasp`)
+        self._grasp_seat_m: dict[str, np.ndarray] = {}
         self._arrived: set[tuple[int, str]] = set()
         #: side → (first compliant line, grasp's first line, grasp segment) of each reach
         #: whose arm the schedule turns compliant in the air before its grasp, 0-based
@@ -476,23 +479,44 @@ class MotionLayer:
                 R_wp @ Rotation.from_rotvec(turn).as_matrix() @ R_wp.T
                 @ rot_z(self._body_yaw_rad()))
 
-    def _body_error_m(self) -> np.ndarray | None:
-        """How far the body stands from the plan's posture relative to the rails that the
-        hands hold (verified grasps, `_held_rails`), across the rails, world frame [m]:
-        the plan's palm against the encoders' palm, both in the pelvis frame, averaged
-        over the holding hands. A verified hand is on its rail, where the plan has the
-        hold once the ladder's placement is taken (the body's target is the same
-        placement), so no odometry enters; None without a held rail."""
+    def _hand_body_error_m(self, side: str, rail: str) -> np.ndarray:
+        """How far the body stands from the plan's posture relative to ``rail``, as
+        ``side``'s hand on it reads it, across the rail, world frame [m]: the plan's palm
+        (the grip centre, on the rail's axis) against the encoders', both in the pelvis
+        frame. No odometry enters. It includes where the grasp seated on its rail
+        against where the ladder estimate has the hold (`_seat_grasp`)."""
         R_wp = self.estimate.T_world_pelvis[:3, :3]
-        errors = []
-        for side, (rail, _planned_m) in sorted(self._held_rails.items()):
-            frame = f"{side[0].upper()}_palm"
-            planned = self.model.frame_in_pelvis(self.trajectory_rad[self._line], frame)[:3, 3]
-            sensed = self.model.frame_in_pelvis(self._pos_rad, frame)[:3, 3]
-            error = R_wp @ (planned - sensed)
-            axis = self._rail_direction(rail)
-            errors.append(error - (error @ axis) * axis)
+        frame = f"{side[0].upper()}_palm"
+        planned = self.model.frame_in_pelvis(self.trajectory_rad[self._line], frame)[:3, 3]
+        sensed = self.model.frame_in_pelvis(self._pos_rad, frame)[:3, 3]
+        error = R_wp @ (planned - sensed)
+        axis = self._rail_direction(rail)
+        return error - (error @ axis) * axis
+
+    def _body_error_m(self, but: str = "") -> np.ndarray | None:
+        """How far the body stands from the plan's posture relative to the rails, across
+        them, world frame [m]: the mean over the hands that hold verified grasps
+        (`_held_rails`), other than ``but``, of what each reads less its grasp's seat;
+        None without one."""
+        errors = [self._hand_body_error_m(side, rail) - self._grasp_seat_m[side]
+                  for side, (rail, _planned_m) in sorted(self._held_rails.items())
+                  if side != but and side in self._grasp_seat_m]
         return np.mean(errors, axis=0) if errors else None
+
+    def _seat_grasp(self, side: str, rail: str, on_floor: bool) -> None:
+        """Record what a newly verified grasp's seat adds to the body error its hand
+        reads (`_hand_body_error_m`). A grasp made from the floor seats where the ladder
+        estimate has its rail (the estimate is fitted to the palms): nothing. A grasp on
+        the ladder seats within the fingers' reach of its hold, up to 2 cm from it
+        (1.8 cm between the two hands' readings on DRC seed 1, 2026-11-29): its reading
+        is taken against the body error that the hands already holding read at that
+        moment, so that the error is carried from grasp to grasp."""
+        if on_floor:
+            self._grasp_seat_m[side] = np.zeros(3)
+            return
+        reading = self._hand_body_error_m(side, rail)
+        body = self._body_error_m(but=side)
+        self._grasp_seat_m[side] = reading - (np.zeros(3) if body is None else body)
 
     def _trim_body(self) -> None:
         """Once the ladder alone carries the robot, move the body back to the plan's
@@ -850,6 +874,7 @@ class MotionLayer:
         observed = RailObservation(g.rail, g.planned_m, palm, self._rail_direction(g.rail))
         on_floor = self._feet_on_floor(self.sidecar.segments[g.segment])
         self.rails.add(observed, fits_yaw=on_floor)
+        self._seat_grasp(g.side, g.rail, on_floor)
         self._held_rails[g.side] = (g.rail, g.planned_m)
         if on_floor:
             # standing on the floor, leg odometry is exact; on the ladder it carries the
