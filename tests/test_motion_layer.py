@@ -327,10 +327,11 @@ def test_once_off_the_floor_the_body_takes_the_ladders_placement(reach):
 
 def test_on_the_ladder_the_body_is_trimmed_back_to_the_held_rails(reach):
     """Once the ladder alone carries the robot, the holding hands' encoders measure how
-    far the body stands across the rails from the plan's posture (a creeping foot, arms
-    pulling on their grips). Every holding limb, a stance foot with no correction of its
-    own included, then moves the body back, within the bound; an error the body has
-    already taken out leaves the trim where it is."""
+    far the body stands towards the ladder from the plan's posture relative to the rails
+    (a creeping foot, arms pulling on their grips). Every holding limb, a stance foot
+    with no correction of its own included, then moves the body back, horizontally,
+    within the bound; an error the body has already taken out leaves the trim where it
+    is. A grasp made on the ladder reads the error against the hands already holding."""
     from execute.motion.estimator import BodyEstimate
     from execute.motion.events import MotionEventKind
     from execute.motion.layer import MotionLayer
@@ -351,8 +352,6 @@ def test_on_the_ladder_the_body_is_trimmed_back_to_the_held_rails(reach):
         layer._seat_grasp(side, f"rail_{side}", on_floor=True)
     layer._follow_holds(seg)  # the holds as they are taken: nothing to realise yet
     assert "left_foot" not in layer._offsets
-    rail_up = layer._rail_direction("rail_left")
-    across = np.eye(3) - np.outer(rail_up, rail_up)
 
     def sensed_with_body_at(offset_m, left_seat_m=np.zeros(3)):
         """The encoders with both hands on their holds (the left one seated
@@ -362,11 +361,10 @@ def test_on_the_ladder_the_body_is_trimmed_back_to_the_held_rails(reach):
             q += layer._limb_shift_dq(f"{side}_hand", line, seat - offset_m, np.eye(3))[0]
         return q
 
-    towards_ladder = -layer.geometry.rung_line_normal
-    body = 0.02 * towards_ladder  # pulled 2 cm towards the ladder
-    layer._pos_rad = sensed_with_body_at(body)
+    towards_ladder = layer.geometry.R_world_ladder[:, 0]  # horizontal
+    layer._pos_rad = sensed_with_body_at(0.02 * towards_ladder)  # pulled 2 cm towards it
     layer._trim_body()
-    assert np.allclose(layer._body_trim_m, -across @ body, atol=1.5e-3)
+    assert layer._body_trim_m == pytest.approx(-0.02, abs=1e-3)
     assert layer.events[-1].kind is MotionEventKind.BODY_TRIM
     layer._follow_holds(seg)
     end = seg.last_line - 1
@@ -375,24 +373,22 @@ def test_on_the_ladder_the_body_is_trimmed_back_to_the_held_rails(reach):
              - layer.model.frame_in_pelvis(traj[end], frame))[:3, 3]
     # the foot pushes it back (horizontally: the fixture's standing leg is near straight,
     # so the foot cannot also move down relative to the pelvis)
-    assert np.allclose(moved[:2], -layer._body_trim_m[:2], atol=1e-3)
+    assert np.allclose(moved, -layer._body_trim_m * towards_ladder, atol=1e-3)
 
-    trim = layer._body_trim_m.copy()
+    trim = layer._body_trim_m
     layer._pos_rad = traj[line].copy()  # the body back where the plan has it
     layer._trim_body()
-    assert np.array_equal(layer._body_trim_m, trim)
-    # the left hand grasps again on the ladder, seated 1.5 cm off its hold, while the
-    # body stands 1 cm from the plan's posture: the body error stays the right hand's
-    seat = np.array([0.0, 0.015, 0.0])
-    body = 0.01 * towards_ladder
-    layer._pos_rad = sensed_with_body_at(body, seat)
+    assert layer._body_trim_m == trim
+    # the left hand grasps again on the ladder, seated 1.5 cm off its hold across the
+    # rail, while the body stands 1 cm from the plan's posture: the body error stays 1 cm
+    layer._pos_rad = sensed_with_body_at(0.01 * towards_ladder,
+                                         0.015 * layer.geometry.rung_line_normal)
     layer._seat_grasp("left", "rail_left", on_floor=False)
-    assert np.allclose(layer._body_error_m(), across @ body, atol=1e-3)
-    assert np.allclose(layer._hand_body_error_m("left", "rail_left"), across @ (body - seat),
-                       atol=1e-3)
+    assert layer._body_error_m() == pytest.approx(0.01, abs=1e-3)
+    assert abs(layer._hand_body_error_m("left", "rail_left") - 0.01) > 0.01
     layer._pos_rad = sensed_with_body_at(0.08 * towards_ladder)  # beyond the bound
     layer._trim_body()
-    assert np.linalg.norm(layer._body_trim_m) == pytest.approx(layer.config.max_body_trim_m)
+    assert abs(layer._body_trim_m) == pytest.approx(layer.config.max_body_trim_m)
 
 
 @pytest.mark.parametrize("field,value", [("max_reach_correction_m", 0.2),

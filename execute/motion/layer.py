@@ -63,9 +63,10 @@ hubo-motion-rt and the thesis's operator did (thesis §4.3.4, §6.2):
   the ladder need no correction of their own (`_body_shift_m`);
 - **the body trimmed to the rails**: once the ladder alone carries the robot, at every
   segment the hands that hold verified grasps measure, by their arms' encoders, how far
-  the body stands across the rails from the plan's posture relative to them (a creeping
-  stance foot, compliant arms pulling on their grips); every holding limb's references
-  then move the body back, within ``max_body_trim_m`` (`_trim_body`).
+  the body stands towards the ladder from the plan's posture relative to the rails (a
+  creeping stance foot, compliant arms pulling on their grips); every holding limb's
+  references then move the body back, horizontally, within ``max_body_trim_m``
+  (`_trim_body`).
 
 Its only input is the daemon's state struct (`execute.motion.sensed_state`). It writes
 references, modes and feed-forward, the same things the open-loop player writes.
@@ -260,12 +261,15 @@ class MotionLayer:
         #: no foot of this segment stands on the floor: the body takes the ladder's
         #: placement (`_body_shift_m`)
         self._body_on_ladder = False
-        #: where the body is moved, on top of the ladder's placement, to stand in the
-        #: plan's posture relative to the held rails, world [m] (`_trim_body`)
-        self._body_trim_m = np.zeros(3)
+        #: horizontal, towards the ladder (world): the direction of the body trim
+        self._towards_ladder = self.geometry.R_world_ladder[:, 0].copy()
+        #: how far the body is moved towards the ladder, on top of the ladder's
+        #: placement, to stand in the plan's posture relative to the held rails [m]
+        #: (`_trim_body`)
+        self._body_trim_m = 0.0
         #: side → what its grasp's own seat adds to the body error it reads [m]
         #: (`_hand_body_error_m`, `_seat_grasp`)
-        self._grasp_seat_m: dict[str, np.ndarray] = {}
+        self._grasp_seat_m: dict[str, float] = {}
         self._arrived: set[tuple[int, str]] = set()
         #: side → (first compliant line, grasp's first line, grasp segment) of each reach
         #: whose arm the schedule turns compliant in the air before its grasp, 0-based
@@ -425,7 +429,8 @@ class MotionLayer:
         trim that takes it back there (`_trim_body`)."""
         if not self._body_on_ladder:
             return np.zeros(3)
-        return self._bounded(self.ladder.correction_m(planned_m)) + self._body_trim_m
+        return (self._bounded(self.ladder.correction_m(planned_m))
+                + self._body_trim_m * self._towards_ladder)
 
     def _body_yaw_rad(self) -> float:
         """The yaw of the body's own placement (`_body_shift_m`) [rad]."""
@@ -479,29 +484,35 @@ class MotionLayer:
                 R_wp @ Rotation.from_rotvec(turn).as_matrix() @ R_wp.T
                 @ rot_z(self._body_yaw_rad()))
 
-    def _hand_body_error_m(self, side: str, rail: str) -> np.ndarray:
-        """How far the body stands from the plan's posture relative to ``rail``, as
-        ``side``'s hand on it reads it, across the rail, world frame [m]: the plan's palm
-        (the grip centre, on the rail's axis) against the encoders', both in the pelvis
-        frame. No odometry enters. It includes where the grasp seated on its rail
-        against where the ladder estimate has the hold (`_seat_grasp`)."""
+    def _hand_body_error_m(self, side: str, rail: str) -> float:
+        """How far the body stands from the plan's posture relative to ``rail``,
+        horizontally towards the ladder, as ``side``'s hand on it reads it [m].
+
+        The plan's palm (the grip centre, on the rail's axis) against the encoders', both
+        in the pelvis frame, gives the body's offset across the rail; along it a grip
+        may slide. Read as a horizontal offset (a stance foot creeps along its tread;
+        the legs, near straight, set the height), it is the across part's component
+        towards the ladder over that direction's share across the rail. No odometry
+        enters. It includes where the grasp seated on its rail against where the
+        ladder estimate has the hold (`_seat_grasp`)."""
         R_wp = self.estimate.T_world_pelvis[:3, :3]
         frame = f"{side[0].upper()}_palm"
         planned = self.model.frame_in_pelvis(self.trajectory_rad[self._line], frame)[:3, 3]
         sensed = self.model.frame_in_pelvis(self._pos_rad, frame)[:3, 3]
-        error = R_wp @ (planned - sensed)
-        axis = self._rail_direction(rail)
-        return error - (error @ axis) * axis
+        n, axis = self._towards_ladder, self._rail_direction(rail)
+        offset = R_wp @ (planned - sensed)
+        across = offset - (offset @ axis) * axis
+        return float(n @ across) / (1.0 - float(n @ axis) ** 2)
 
-    def _body_error_m(self, but: str = "") -> np.ndarray | None:
-        """How far the body stands from the plan's posture relative to the rails, across
-        them, world frame [m]: the mean over the hands that hold verified grasps
-        (`_held_rails`), other than ``but``, of what each reads less its grasp's seat;
-        None without one."""
+    def _body_error_m(self, but: str = "") -> float | None:
+        """How far the body stands from the plan's posture relative to the rails,
+        horizontally towards the ladder [m]: the mean over the hands that hold verified
+        grasps (`_held_rails`), other than ``but``, of what each reads less its grasp's
+        seat; None without one."""
         errors = [self._hand_body_error_m(side, rail) - self._grasp_seat_m[side]
                   for side, (rail, _planned_m) in sorted(self._held_rails.items())
                   if side != but and side in self._grasp_seat_m]
-        return np.mean(errors, axis=0) if errors else None
+        return float(np.mean(errors)) if errors else None
 
     def _seat_grasp(self, side: str, rail: str, on_floor: bool) -> None:
         """Record what a newly verified grasp's seat adds to the body error its hand
@@ -512,37 +523,34 @@ class MotionLayer:
         is taken against the body error that the hands already holding read at that
         moment, so that the error is carried from grasp to grasp."""
         if on_floor:
-            self._grasp_seat_m[side] = np.zeros(3)
+            self._grasp_seat_m[side] = 0.0
             return
-        reading = self._hand_body_error_m(side, rail)
         body = self._body_error_m(but=side)
-        self._grasp_seat_m[side] = reading - (np.zeros(3) if body is None else body)
+        self._grasp_seat_m[side] = self._hand_body_error_m(side, rail) - (body or 0.0)
 
     def _trim_body(self) -> None:
         """Once the ladder alone carries the robot, move the body back to the plan's
-        posture relative to the held rails (`_body_error_m`): the trim integrates the
-        error, within ``max_body_trim_m``, and every holding limb realises it over the
-        segment (`_follow_holds`). A stance foot that creeps on its rung carries the body
-        with it (2–3 cm over a DRC climb), and compliant arms that pull on their grips
-        draw it towards the ladder (2.1 cm on `ship`, where the plan keeps a shin 2 cm
-        clear of its rung): leg odometry sees neither, the arms' encoders both."""
+        posture relative to the held rails (`_body_error_m`), horizontally: the trim
+        integrates the error, within ``max_body_trim_m``, and every holding limb
+        realises it over the segment (`_follow_holds`). A stance foot that creeps on its
+        rung carries the body with it (2–3 cm over a DRC climb), and compliant arms that
+        pull on their grips draw it towards the ladder (2.1 cm on `ship`, where the plan
+        keeps a shin 2 cm clear of its rung): leg odometry sees neither, the arms'
+        encoders both. Across the rail the body's height shows too; a trim that also
+        lifted the body wound up against legs near straight (DRC seed 1 tripped LHR,
+        2026-11-29)."""
         cap = self.config.max_body_trim_m
         if not self._body_on_ladder or cap <= 0.0:
-            self._body_trim_m = np.zeros(3)
+            self._body_trim_m = 0.0
             return
         error = self._body_error_m()
-        if error is None or float(np.linalg.norm(error)) < BODY_TRIM_DEADBAND_M:
+        if error is None or abs(error) < BODY_TRIM_DEADBAND_M:
             return
-        trim = self._body_trim_m - error
-        length = float(np.linalg.norm(trim))
-        if length > cap:
-            trim *= cap / length
-        self._event(MotionEventKind.BODY_TRIM, "",
-                    float(np.linalg.norm(trim - self._body_trim_m)),
-                    f"the holding hands put the body {np.round(error * 100, 1).tolist()} cm "
-                    "across the rails from the plan's posture; its placement moves by "
-                    f"{np.round((trim - self._body_trim_m) * 100, 1).tolist()} cm (trim "
-                    f"{np.round(trim * 100, 1).tolist()} cm)")
+        trim = float(np.clip(self._body_trim_m - error, -cap, cap))
+        self._event(MotionEventKind.BODY_TRIM, "", abs(trim - self._body_trim_m),
+                    f"the holding hands put the body {error * 100:+.1f} cm towards the ladder "
+                    f"from the plan's posture; it moves {(trim - self._body_trim_m) * 100:+.1f} "
+                    f"cm (trim {trim * 100:+.1f} cm)")
         self._body_trim_m = trim
 
     def _follow_holds(self, seg: Segment) -> None:
@@ -1230,7 +1238,7 @@ class MotionLayer:
             "counts": counts,
             "ladder_shift_m": [round(float(v), 4) for v in self.ladder.shift_m],
             "ladder_yaw_rad": round(self.ladder.yaw_rad, 4),
-            "body_trim_m": [round(float(v), 4) for v in self._body_trim_m],
+            "body_trim_m": round(self._body_trim_m, 4),
             "leg_relief_peak_n": round(self.leg_relief.peak_lift_n, 1),
             "leg_relief_joint": self.leg_relief.peak_joint,
             "stop": None if self.stop is None else dataclasses.asdict(self.stop),
