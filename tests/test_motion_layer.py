@@ -342,9 +342,12 @@ def test_on_the_ladder_the_body_is_trimmed_back_to_the_held_rails(reach):
     assert {"left_hand", "right_hand", "left_foot"} <= set(seg.holds)
     layer = MotionLayer(TrajectoryPlayer(traj, PlayerOptions(rate_hz=int(sc.rate_hz))),
                         traj, sc, ladder)
-    layer.estimate = BodyEstimate(0.0, np.eye(4), np.eye(3), {"left": True, "right": True},
-                                  {}, {}, {"left": 0.09, "right": 0.09})
     layer._line = line = seg.first_line - 1
+    T_world_pelvis = np.eye(4)  # the body at the plan's attitude
+    T_world_pelvis[:3, :3] = layer._planned_pelvis_rotation()
+    layer.estimate = BodyEstimate(0.0, T_world_pelvis, T_world_pelvis[:3, :3],
+                                  {"left": True, "right": True}, {}, {},
+                                  {"left": 0.09, "right": 0.09})
     layer._body_on_ladder = True
     layer._held_rails = {side: (f"rail_{side}", np.asarray(seg.holds[f"{side}_hand"].position_m))
                          for side in ("left", "right")}

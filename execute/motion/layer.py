@@ -488,21 +488,37 @@ class MotionLayer:
         """How far the body stands from the plan's posture relative to ``rail``,
         horizontally towards the ladder, as ``side``'s hand on it reads it [m].
 
-        The plan's palm (the grip centre, on the rail's axis) against the encoders', both
-        in the pelvis frame, gives the body's offset across the rail; along it a grip
-        may slide. Read as a horizontal offset (a stance foot creeps along its tread;
-        the legs, near straight, set the height), it is the across part's component
-        towards the ladder over that direction's share across the rail. No odometry
-        enters. It includes where the grasp seated on its rail against where the
-        ladder estimate has the hold (`_seat_grasp`)."""
-        R_wp = self.estimate.T_world_pelvis[:3, :3]
+        The plan's palm (the grip centre, on the rail's axis) from its pelvis, turned
+        by the plan's attitude of the pelvis (`_planned_pelvis_rotation`), against the
+        encoders' palm from the pelvis, turned by the estimated attitude, gives the
+        body's offset across the rail; along it a grip may slide. Read as a horizontal
+        offset (a stance foot creeps along its tread; the legs, near straight, set the
+        height), it is the across part's component towards the ladder over that
+        direction's share across the rail. No odometry enters. It includes where the
+        grasp seated on its rail against where the ladder estimate has the hold
+        (`_seat_grasp`)."""
         frame = f"{side[0].upper()}_palm"
         planned = self.model.frame_in_pelvis(self.trajectory_rad[self._line], frame)[:3, 3]
         sensed = self.model.frame_in_pelvis(self._pos_rad, frame)[:3, 3]
         n, axis = self._towards_ladder, self._rail_direction(rail)
-        offset = R_wp @ (planned - sensed)
+        offset = (self._planned_pelvis_rotation() @ planned
+                  - self.estimate.T_world_pelvis[:3, :3] @ sensed)
         across = offset - (offset @ axis) * axis
         return float(n @ across) / (1.0 - float(n @ axis) ** 2)
+
+    def _planned_pelvis_rotation(self) -> np.ndarray:
+        """The plan's attitude of the pelvis on this line, world frame, with the body's
+        own placement's yaw (`_body_yaw_rad`): from a foot the segment holds, its sole
+        flat on its tread (check-plan places the plan's body the same way). A pitch of
+        1° between the plan's body and the real one moves a palm 0.9 cm relative to the
+        pelvis; the DRC body stood 2.3° off the plan's (2026-11-29)."""
+        seg = self.sidecar.segments[int(self._segment_of_line[self._line])]
+        foot = next(limb for limb in ("left_foot", "right_foot") if limb in seg.holds)
+        R_world_sole = (np.eye(3) if seg.holds[foot].target == "floor"
+                        else self.geometry.R_world_ladder)
+        R_pelvis_sole = self.model.frame_in_pelvis(self.trajectory_rad[self._line],
+                                                   f"{foot[0].upper()}_sole")[:3, :3]
+        return rot_z(self._body_yaw_rad()) @ R_world_sole @ R_pelvis_sole.T
 
     def _body_error_m(self, but: str = "") -> float | None:
         """How far the body stands from the plan's posture relative to the rails,
@@ -547,6 +563,8 @@ class MotionLayer:
         if error is None or abs(error) < BODY_TRIM_DEADBAND_M:
             return
         trim = float(np.clip(self._body_trim_m - error, -cap, cap))
+        if trim == self._body_trim_m:
+            return  # at its bound
         self._event(MotionEventKind.BODY_TRIM, "", abs(trim - self._body_trim_m),
                     f"the holding hands put the body {error * 100:+.1f} cm towards the ladder "
                     f"from the plan's posture; it moves {(trim - self._body_trim_m) * 100:+.1f} "
