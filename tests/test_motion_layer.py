@@ -334,7 +334,7 @@ def test_on_the_ladder_the_body_is_trimmed_back_to_the_held_rails(reach):
     is. A grasp made on the ladder reads the error against the hands already holding."""
     from execute.motion.estimator import BodyEstimate
     from execute.motion.events import MotionEventKind
-    from execute.motion.layer import MotionLayer
+    from execute.motion.layer import BODY_TRIM_GAIN, MotionLayer
     from execute.play.player import PlayerOptions, TrajectoryPlayer
 
     _path, traj, sc, ladder = reach
@@ -356,18 +356,20 @@ def test_on_the_ladder_the_body_is_trimmed_back_to_the_held_rails(reach):
     layer._follow_holds(seg)  # the holds as they are taken: nothing to realise yet
     assert "left_foot" not in layer._offsets
 
-    def sensed_with_body_at(offset_m, left_seat_m=np.zeros(3)):
+    def sensed_with_body_at(offset_m, left_seat_m=(0.0, 0.0, 0.0)):
         """The encoders with both hands on their holds (the left one seated
         ``left_seat_m`` from it) and the body ``offset_m`` away."""
         q = traj[line].copy()
-        for side, seat in (("left", left_seat_m), ("right", np.zeros(3))):
+        for side, seat in (("left", np.asarray(left_seat_m)), ("right", np.zeros(3))):
             q += layer._limb_shift_dq(f"{side}_hand", line, seat - offset_m, np.eye(3))[0]
         return q
 
     towards_ladder = layer.geometry.R_world_ladder[:, 0]  # horizontal
     layer._pos_rad = sensed_with_body_at(0.02 * towards_ladder)  # pulled 2 cm towards it
     layer._trim_body()
-    assert layer._body_trim_m == pytest.approx(-0.02, abs=1e-3)
+    assert layer._body_trim_m == pytest.approx(-0.02 * BODY_TRIM_GAIN, abs=1e-3)
+    layer._trim_body()  # the body did not move: the trim integrates
+    assert layer._body_trim_m == pytest.approx(-0.04 * BODY_TRIM_GAIN, abs=1e-3)
     assert layer.events[-1].kind is MotionEventKind.BODY_TRIM
     layer._follow_holds(seg)
     end = seg.last_line - 1

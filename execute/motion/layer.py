@@ -131,6 +131,10 @@ SAME_TARGET_M = 0.005
 #: A body error across the rails smaller than this does not move the body [m]: a grip
 #: holds its rail anywhere within a few millimetres of the palm's planned point.
 BODY_TRIM_DEADBAND_M = 0.005
+#: Share of the body error the trim takes out at each segment: at 1 the error read at
+#: the next segment changed sign at most segments (over-correction; DRC seed 1 swung
+#: from −2.8 to +4.4 cm within 8 s, 2026-11-29); half damps it.
+BODY_TRIM_GAIN = 0.5
 #: A stiff arm whose motor currents say a joint has pushed harder than this share of its
 #: torque limit for `STIFF_ARM_YIELD_S` complies again: its open hand pushes on the rail
 #: or a rung (a stiff re-reach on `stair` tripped a shoulder's board so, 2026-11-27; a
@@ -547,7 +551,7 @@ class MotionLayer:
     def _trim_body(self) -> None:
         """Once the ladder alone carries the robot, move the body back to the plan's
         posture relative to the held rails (`_body_error_m`), horizontally: the trim
-        integrates the error, within ``max_body_trim_m``, and every holding limb
+        integrates the error (`BODY_TRIM_GAIN`), within ``max_body_trim_m``, and every holding limb
         realises it over the segment (`_follow_holds`). A stance foot that creeps on its
         rung carries the body with it (2–3 cm over a DRC climb), and compliant arms that
         pull on their grips draw it towards the ladder (2.1 cm on `ship`, where the plan
@@ -562,7 +566,7 @@ class MotionLayer:
         error = self._body_error_m()
         if error is None or abs(error) < BODY_TRIM_DEADBAND_M:
             return
-        trim = float(np.clip(self._body_trim_m - error, -cap, cap))
+        trim = float(np.clip(self._body_trim_m - BODY_TRIM_GAIN * error, -cap, cap))
         if trim == self._body_trim_m:
             return  # at its bound
         self._event(MotionEventKind.BODY_TRIM, "", abs(trim - self._body_trim_m),
