@@ -341,7 +341,7 @@ def test_on_the_ladder_the_body_is_trimmed_back_to_the_held_rails(reach):
     seg = sc.segments[-1]
     assert {"left_hand", "right_hand", "left_foot"} <= set(seg.holds)
     layer = MotionLayer(TrajectoryPlayer(traj, PlayerOptions(rate_hz=int(sc.rate_hz))),
-                        traj, sc, ladder)
+                        traj, sc, ladder, config=MotionConfig(max_body_trim_m=0.03))
     layer._line = line = seg.first_line - 1
     T_world_pelvis = np.eye(4)  # the body at the plan's attitude
     T_world_pelvis[:3, :3] = layer._planned_pelvis_rotation()

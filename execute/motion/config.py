@@ -123,10 +123,11 @@ class MotionConfig:
             (each reach is corrected instead) [m].
         max_body_trim_m: once the ladder alone carries the robot, the body is moved back
             to the plan's posture relative to the rails its hands hold, as their arms'
-            encoders measure it, by at most this [m]; 0: never. A stance foot creeping on
-            its rung and compliant arms pulling on their grips move the body 2–3 cm
-            towards the ladder over a climb, where the plan keeps its shins 1–2.5 cm
-            clear of the rungs.
+            encoders measure it, by at most this [m]; 0: never (the default: on, it
+            tripped hip rolls and climbed fewer DRC draws, docs/decisions/body-trim.md).
+            A stance foot creeping on its rung and compliant arms pulling on their grips
+            move the body 1–3 cm towards the ladder over a climb, where the plan keeps
+            its shins 1–2.5 cm clear of the rungs.
         estimator: the state estimator's thresholds.
     """
 
@@ -154,7 +155,7 @@ class MotionConfig:
     strike_tries: int = 2
     hand_strike_load_n: float = 15.0
     replan_beyond_m: float = 0.0
-    max_body_trim_m: float = 0.03
+    max_body_trim_m: float = 0.0
     estimator: EstimatorConfig = field(default_factory=EstimatorConfig)
 
     def __post_init__(self) -> None:
@@ -202,7 +203,8 @@ def add_motion_arguments(parser: argparse.ArgumentParser) -> None:
                         metavar="M",
                         help="closed loop: largest move of the body back to the plan's "
                              "posture relative to the rails its hands hold [m], "
-                             + within("max_body_trim_m") + ", 0 never")
+                             + within("max_body_trim_m") + ", 0 never (experimental: "
+                             "docs/decisions/body-trim.md)")
 
 
 def motion_config_from_args(args: argparse.Namespace) -> MotionConfig:

@@ -590,7 +590,13 @@ class MotionLayer:
             self._hold_corrections.pop(limb, None)
         for limb, hold in seg.holds.items():
             planned_m = np.asarray(hold.position_m)
+            trimmed = self.config.max_body_trim_m > 0.0
             if limb not in self._hold_corrections:
+                if limb not in self._offsets and not trimmed:
+                    # no correction of its own: it stays where the plan has it relative
+                    # to the body (its share of the ladder's placement was under
+                    # `MIN_CORRECTION_M`); only the body trim moves the body further
+                    continue
                 q_held = self.trajectory_rad[self._line] + self._offset(limb)
                 self._hold_corrections[limb] = self._correction_at(limb, q_held, planned_m)
             shift_world_m, turn_world = self._hold_corrections[limb]
