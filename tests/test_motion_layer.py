@@ -390,7 +390,7 @@ def test_on_the_ladder_the_body_is_trimmed_back_to_the_held_rails(reach):
                                          0.015 * layer.geometry.rung_line_normal)
     layer._seat_grasp("left", "rail_left", on_floor=False)
     assert layer._body_error_m() == pytest.approx(0.01, abs=1e-3)
-    assert abs(layer._hand_body_error_m("left", "rail_left") - 0.01) > 0.01
+    assert abs(layer._hand_readings_m({"left": "rail_left"})["left"] - 0.01) > 0.01
     layer._pos_rad = sensed_with_body_at(0.08 * towards_ladder)  # beyond the bound
     layer._trim_body()
     assert abs(layer._body_trim_m) == pytest.approx(layer.config.max_body_trim_m)

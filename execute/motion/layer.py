@@ -272,7 +272,7 @@ class MotionLayer:
         #: (`_trim_body`)
         self._body_trim_m = 0.0
         #: side → what its grasp's own seat adds to the body error it reads [m]
-        #: (`_hand_body_error_m`, `_seat_grasp`)
+        #: (`_hand_readings_m`, `_seat_grasp`)
         self._grasp_seat_m: dict[str, float] = {}
         self._arrived: set[tuple[int, str]] = set()
         #: side → (first compliant line, grasp's first line, grasp segment) of each reach
@@ -488,9 +488,11 @@ class MotionLayer:
                 R_wp @ Rotation.from_rotvec(turn).as_matrix() @ R_wp.T
                 @ rot_z(self._body_yaw_rad()))
 
-    def _hand_body_error_m(self, side: str, rail: str) -> float:
-        """How far the body stands from the plan's posture relative to ``rail``,
-        horizontally towards the ladder, as ``side``'s hand on it reads it [m].
+    def _hand_readings_m(self, rails: dict[str, str]) -> dict[str, float]:
+        """side → how far the body stands from the plan's posture relative to its rail
+        (``rails``: side → rail), horizontally towards the ladder, as that hand on it
+        reads it [m]; the palms of all the hands from one forward kinematics each of the
+        plan's line and of the encoders.
 
         The plan's palm (the grip centre, on the rail's axis) from its pelvis, turned
         by the plan's attitude of the pelvis (`_planned_pelvis_rotation`), against the
@@ -501,14 +503,19 @@ class MotionLayer:
         direction's share across the rail. No odometry enters. It includes where the
         grasp seated on its rail against where the ladder estimate has the hold
         (`_seat_grasp`)."""
-        frame = f"{side[0].upper()}_palm"
-        planned = self.model.frame_in_pelvis(self.trajectory_rad[self._line], frame)[:3, 3]
-        sensed = self.model.frame_in_pelvis(self._pos_rad, frame)[:3, 3]
-        n, axis = self._towards_ladder, self._rail_direction(rail)
-        offset = (self._planned_pelvis_rotation() @ planned
-                  - self.estimate.T_world_pelvis[:3, :3] @ sensed)
-        across = offset - (offset @ axis) * axis
-        return float(n @ across) / (1.0 - float(n @ axis) ** 2)
+        palms = tuple(f"{side[0].upper()}_palm" for side in rails)
+        planned = self.model.frames_in_pelvis(self.trajectory_rad[self._line], palms)
+        sensed = self.model.frames_in_pelvis(self._pos_rad, palms)
+        R_plan = self._planned_pelvis_rotation()
+        R_est = self.estimate.T_world_pelvis[:3, :3]
+        n = self._towards_ladder
+        out = {}
+        for (side, rail), palm in zip(rails.items(), palms, strict=True):
+            offset = R_plan @ planned[palm][:3, 3] - R_est @ sensed[palm][:3, 3]
+            axis = self._rail_direction(rail)
+            across = offset - (offset @ axis) * axis
+            out[side] = float(n @ across) / (1.0 - float(n @ axis) ** 2)
+        return out
 
     def _planned_pelvis_rotation(self) -> np.ndarray:
         """The plan's attitude of the pelvis on this line, world frame, with the body's
@@ -529,40 +536,49 @@ class MotionLayer:
         horizontally towards the ladder [m]: the mean over the hands that hold verified
         grasps (`_held_rails`), other than ``but``, of what each reads less its grasp's
         seat; None without one."""
-        errors = [self._hand_body_error_m(side, rail) - self._grasp_seat_m[side]
-                  for side, (rail, _planned_m) in sorted(self._held_rails.items())
-                  if side != but and side in self._grasp_seat_m]
-        return float(np.mean(errors)) if errors else None
+        held = {side: rail for side, (rail, _planned_m) in sorted(self._held_rails.items())
+                if side != but and side in self._grasp_seat_m}
+        if not held:
+            return None
+        readings = self._hand_readings_m(held)
+        return float(np.mean([readings[side] - self._grasp_seat_m[side] for side in held]))
 
     def _seat_grasp(self, side: str, rail: str, on_floor: bool) -> None:
-        """Record what a newly verified grasp's seat adds to the body error its hand
-        reads (`_hand_body_error_m`). A grasp made from the floor seats where the ladder
-        estimate has its rail (the estimate is fitted to the palms): nothing. A grasp on
-        the ladder seats within the fingers' reach of its hold, up to 2 cm from it
-        (1.8 cm between the two hands' readings on DRC seed 1, 2026-11-29): its reading
-        is taken against the body error that the hands already holding read at that
-        moment, so that the error is carried from grasp to grasp."""
+        """With the body trim on, record what a newly verified grasp's seat adds to the
+        body error its hand reads (`_hand_readings_m`). A grasp made from the floor seats
+        where the ladder estimate has its rail (the estimate is fitted to the palms):
+        nothing. A grasp on the ladder seats within the fingers' reach of its hold, up to
+        2 cm from it (1.8 cm between the two hands' readings on DRC seed 1, 2026-11-29):
+        its reading is taken against the body error that the hands already holding read
+        at that moment, so that the error is carried from grasp to grasp."""
+        if not self._trims_body:
+            return
         if on_floor:
             self._grasp_seat_m[side] = 0.0
             return
         body = self._body_error_m(but=side)
-        self._grasp_seat_m[side] = self._hand_body_error_m(side, rail) - (body or 0.0)
+        self._grasp_seat_m[side] = self._hand_readings_m({side: rail})[side] - (body or 0.0)
+
+    @property
+    def _trims_body(self) -> bool:
+        """The body trim is on (``max_body_trim_m`` above 0)."""
+        return self.config.max_body_trim_m > 0.0
 
     def _trim_body(self) -> None:
         """Once the ladder alone carries the robot, move the body back to the plan's
         posture relative to the held rails (`_body_error_m`), horizontally: the trim
-        integrates the error (`BODY_TRIM_GAIN`), within ``max_body_trim_m``, and every holding limb
-        realises it over the segment (`_follow_holds`). A stance foot that creeps on its
-        rung carries the body with it (2–3 cm over a DRC climb), and compliant arms that
-        pull on their grips draw it towards the ladder (2.1 cm on `ship`, where the plan
-        keeps a shin 2 cm clear of its rung): leg odometry sees neither, the arms'
-        encoders both. Across the rail the body's height shows too; a trim that also
-        lifted the body wound up against legs near straight (DRC seed 1 tripped LHR,
-        2026-11-29)."""
-        cap = self.config.max_body_trim_m
-        if not self._body_on_ladder or cap <= 0.0:
+        integrates the error (`BODY_TRIM_GAIN`), within ``max_body_trim_m``, and every
+        holding limb realises it over the segment (`_follow_holds`). A stance foot that
+        creeps on its rung carries the body with it (2–3 cm over a DRC climb), and
+        compliant arms that pull on their grips draw it towards the ladder (2.1 cm on
+        `ship`, where the plan keeps a shin 2 cm clear of its rung): leg odometry sees
+        neither, the arms' encoders both. Across the rail the body's height shows too; a
+        trim that also lifted the body wound up against legs near straight (DRC seed 1
+        tripped LHR, 2026-11-29)."""
+        if not (self._trims_body and self._body_on_ladder):
             self._body_trim_m = 0.0
             return
+        cap = self.config.max_body_trim_m
         error = self._body_error_m()
         if error is None or abs(error) < BODY_TRIM_DEADBAND_M:
             return
@@ -590,9 +606,8 @@ class MotionLayer:
             self._hold_corrections.pop(limb, None)
         for limb, hold in seg.holds.items():
             planned_m = np.asarray(hold.position_m)
-            trimmed = self.config.max_body_trim_m > 0.0
             if limb not in self._hold_corrections:
-                if limb not in self._offsets and not trimmed:
+                if limb not in self._offsets and not self._trims_body:
                     # no correction of its own: it stays where the plan has it relative
                     # to the body (its share of the ladder's placement was under
                     # `MIN_CORRECTION_M`); only the body trim moves the body further
