@@ -246,11 +246,20 @@ def home_one_joint_from_the_page(page: Page, joint: str) -> None:
     daemon's own state channel shows it homed (and no other), then the page does."""
     b = page.browser
     b.wait_for("document.body.innerText.includes('homed 0/40')")
-    b.click(".q-select")
-    b.wait_for("[...document.querySelectorAll('.q-item')].some(e => "
-               f"e.textContent.trim() === {joint!r})")
-    b.click(".q-item", joint)
-    b.wait_for(f"document.querySelector('.q-select').textContent.includes({joint!r})")
+    chosen = f"document.querySelector('.q-select').textContent.includes({joint!r})"
+    for attempt in range(5):  # a click during the menu's opening animation can miss
+        if not b.evaluate("document.querySelector('.q-menu') !== null"):
+            b.click(".q-select")
+        b.wait_for("[...document.querySelectorAll('.q-item')].some(e => "
+                   f"e.textContent.trim() === {joint!r})")
+        time.sleep(0.3)
+        b.click(".q-item", joint)
+        try:
+            b.wait_for(chosen, 5.0)
+            break
+        except AssertionError:
+            if attempt == 4:
+                raise
     b.click("button", "Home")
     j = JOINT_INDEX[joint]
     s = page.daemon.wait_until(lambda s: s["zeroed"][j], 10.0)
