@@ -94,6 +94,34 @@ def shoulder_room_along_m(geom: LadderGeometry, params: RobotParams, rung: int,
     return float((torso_along_m + np.sqrt(ahead_sq_m2)) / np.cos(spec.slope_rad))
 
 
+#: A sole's centre stands at least this far, horizontally, behind the back edge of the
+#: tread above its own [m]: the shin's room under that tread. The ball-of-foot seed
+#: (`primitives.hold_seeds.FOOT_ALONG_M`) leaves 0.185 m on the DRC ladder and 0.177 m on
+#: the stair, which both climb with it; the ship ladder's closer rungs (0.254 m apart,
+#: treads 0.178 m deep) leave 0.129 m, and there the search found the mount's right step
+#: only with the legs' clearance relaxed to 1 cm, after 35-71 failed samples, and the
+#: shin then met rung 1 in MuJoCo (docs/decisions/leg-clearance.md).
+SHIN_ROOM_M = 0.175
+#: The tread keeps at least this much of a sole on it (or all of a shallower tread: the
+#: DRC's 0.102 m carries 0.10 m at the seed) when the shin's room moves the sole back [m].
+TREAD_UNDER_SOLE_M = 0.10
+
+
+def shin_room_along_m(geom: LadderGeometry, params: RobotParams) -> float:
+    """The furthest up-ladder offset from its tread's centre (x_L) [m] at which a sole's
+    centre keeps `SHIN_ROOM_M` behind the back edge of the tread above, but no further
+    back than leaves `TREAD_UNDER_SOLE_M` of the sole on its own tread; +inf on round
+    rungs, which carry the sole under the ball of the foot, along a line."""
+    spec = geom.spec
+    if spec.rung_shape != "box":
+        return np.inf
+    half_depth_m = spec.rung_depth_m / 2
+    above_m = spec.rung_spacing_m / np.tan(spec.slope_rad) - half_depth_m  # its back edge
+    on_tread_m = min(spec.rung_depth_m, TREAD_UNDER_SOLE_M)
+    return float(max(above_m - SHIN_ROOM_M,
+                     on_tread_m - half_depth_m - params.foot_length_m / 2))
+
+
 #: The feet's centre of pressure is kept this far inside the sole's support (the sole,
 #: or the part of it on a tread) [m]. The torque LP's optimum is a vertex, which puts a
 #: centre of pressure on the support's edge, where a real sole rocks and the hands take
@@ -151,7 +179,8 @@ def make_hold(seed: HoldSeed, geom: LadderGeometry, params: RobotParams,
         return Hold(seed.limb, "floor", T, _to_world(T, patch.corners()), np.tile(up, (4, 1)),
                     foot_mu, limits=patch)
     if isinstance(seed, RungSeed):
-        along, lateral = seed.along_m + offset_m[0], seed.lateral_m + offset_m[1]
+        along = min(seed.along_m, shin_room_along_m(geom, params)) + offset_m[0]
+        lateral = seed.lateral_m + offset_m[1]
         p = geom.rung_top_point(seed.rung, lateral_m=lateral, along_m=along)
         T = _pose(geom.R_world_ladder, p)
         # The tread's centre lies at -along in the sole frame.
