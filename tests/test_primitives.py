@@ -10,9 +10,12 @@ from ladders.loader import load_ladder
 from planner.holds import (
     FOOT_COP_MARGIN_M,
     FOOT_FRICTION_SHARE,
+    SHIN_ROOM_M,
+    TREAD_UNDER_SOLE_M,
     make_hold,
     palm_rotation,
     rail_point,
+    shin_room_along_m,
 )
 from primitives import RailSeed, RungSeed, climb_sequence
 from primitives.hold_seeds import FOOT_ALONG_M, MOUNT_ALONG_RAIL_M
@@ -39,7 +42,8 @@ def test_foot_holds_rest_on_their_rung(name):
     geom = LadderGeometry(spec)
     for rung in (0, spec.num_rungs - 1):
         hold = make_hold(RungSeed("left_foot", rung, 0.11), geom, DRC_HUBO)
-        top = geom.rung_top_point(rung, lateral_m=0.11, along_m=FOOT_ALONG_M)
+        along_m = min(FOOT_ALONG_M, shin_room_along_m(geom, DRC_HUBO))
+        top = geom.rung_top_point(rung, lateral_m=0.11, along_m=along_m)
         np.testing.assert_allclose(hold.T_world_frame[:3, 3], top, atol=1e-12)
         # A foot is planned to a share of the ladder's friction.
         assert np.all(hold.normals[:, 2] == 1.0)
@@ -54,6 +58,35 @@ def test_foot_holds_rest_on_their_rung(name):
         assert np.all(np.abs(along) <= spec.rung_depth_m / 2 - FOOT_COP_MARGIN_M + 1e-9)
         aside = np.abs(local[:, 1] - geom.to_ladder(hold.T_world_frame[:3, 3])[1])
         np.testing.assert_allclose(aside, DRC_HUBO.foot_width_m / 2 - FOOT_COP_MARGIN_M)
+
+
+def test_a_foot_on_close_box_treads_stands_back_for_its_shin():
+    """A foot's seed keeps its shin `SHIN_ROOM_M` behind the back edge of the tread
+    above, while `TREAD_UNDER_SOLE_M` of the sole stays on its own tread: on `ship`
+    (rungs 0.254 m apart) the feet stand back, as far as the tread allows; on `drc` and
+    `stair` they stay at the ball-of-foot seed; on round rungs the ball stays on the rung."""
+    def placed(spec):
+        geom = LadderGeometry(spec)
+        hold = make_hold(RungSeed("left_foot", 1, 0.11), geom, DRC_HUBO)
+        along = geom.to_ladder(hold.T_world_frame[:3, 3])[0] - spec.rung_run_m(1)
+        back_edge_above = spec.rung_spacing_m / np.tan(spec.slope_rad) - spec.rung_depth_m / 2
+        on_tread = min(along + DRC_HUBO.foot_length_m / 2, spec.rung_depth_m / 2) \
+            + spec.rung_depth_m / 2
+        return along, back_edge_above - along, on_tread
+
+    for name in ("drc", "stair"):
+        along, room, _ = placed(load_ladder(name))
+        assert along == pytest.approx(FOOT_ALONG_M) and room >= SHIN_ROOM_M
+    ship = load_ladder("ship")
+    along, room, on_tread = placed(ship)
+    assert along < FOOT_ALONG_M - 0.03  # 3.9 cm further back
+    assert room > SHIN_ROOM_M - 0.01 and on_tread == pytest.approx(TREAD_UNDER_SOLE_M)
+    wider = replace(ship, rung_spacing_m=0.30)  # room enough before the tread runs out
+    along, room, on_tread = placed(wider)
+    assert room == pytest.approx(SHIN_ROOM_M) and on_tread > TREAD_UNDER_SOLE_M
+    assert FOOT_ALONG_M - 0.03 < along < FOOT_ALONG_M
+    round_rungs = replace(ship, rung_shape="cylinder", rung_depth_m=0.04)
+    assert placed(round_rungs)[0] == pytest.approx(FOOT_ALONG_M)
 
 
 def test_rail_holds_follow_the_ladder_placement():
