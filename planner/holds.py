@@ -97,10 +97,11 @@ def shoulder_room_along_m(geom: LadderGeometry, params: RobotParams, rung: int,
 #: A sole's centre stands at least this far, horizontally, behind the back edge of the
 #: tread above its own [m]: the shin's room under that tread. The ball-of-foot seed
 #: (`primitives.hold_seeds.FOOT_ALONG_M`) leaves 0.185 m on the DRC ladder and 0.177 m on
-#: the stair, which both climb with it; the ship ladder's closer rungs (0.254 m apart,
-#: treads 0.178 m deep) leave 0.129 m, and there the search found the mount's right step
-#: only with the legs' clearance relaxed to 1 cm, after 35-71 failed samples, and the
-#: shin then met rung 1 in MuJoCo (docs/decisions/leg-clearance.md).
+#: the stair, which both climb with it (this is the less of the two, rounded down); the
+#: ship ladder's closer rungs (0.254 m apart, treads 0.178 m deep) leave 0.129 m, and
+#: there the search found the mount's right step only with the legs' clearance relaxed to
+#: 1 cm, after 31-71 failed samples, and the shin then met rung 1 in MuJoCo
+#: (docs/decisions/shin-room.md).
 SHIN_ROOM_M = 0.175
 #: The tread keeps at least this much of a sole on it (or all of a shallower tread: the
 #: DRC's 0.102 m carries 0.10 m at the seed) when the shin's room moves the sole back [m].
