@@ -117,7 +117,7 @@ def shin_room_along_m(geom: LadderGeometry, params: RobotParams) -> float:
     if spec.rung_shape != "box":
         return np.inf
     half_depth_m = spec.rung_depth_m / 2
-    above_m = spec.rung_spacing_m / np.tan(spec.slope_rad) - half_depth_m  # its back edge
+    above_m = spec.rung_run_m(1) - spec.rung_run_m(0) - half_depth_m  # its back edge
     on_tread_m = min(spec.rung_depth_m, TREAD_UNDER_SOLE_M)
     return float(max(above_m - SHIN_ROOM_M,
                      on_tread_m - half_depth_m - params.foot_length_m / 2))

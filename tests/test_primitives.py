@@ -69,7 +69,7 @@ def test_a_foot_on_close_box_treads_stands_back_for_its_shin():
         geom = LadderGeometry(spec)
         hold = make_hold(RungSeed("left_foot", 1, 0.11), geom, DRC_HUBO)
         along = geom.to_ladder(hold.T_world_frame[:3, 3])[0] - spec.rung_run_m(1)
-        back_edge_above = spec.rung_spacing_m / np.tan(spec.slope_rad) - spec.rung_depth_m / 2
+        back_edge_above = spec.rung_run_m(2) - spec.rung_run_m(1) - spec.rung_depth_m / 2
         on_tread = min(along + DRC_HUBO.foot_length_m / 2, spec.rung_depth_m / 2) \
             + spec.rung_depth_m / 2
         return along, back_edge_above - along, on_tread
