@@ -255,14 +255,16 @@ def home_one_joint_from_the_page(page: Page, joint: str) -> None:
         time.sleep(0.3)
         b.click(".q-item", joint)
         try:
-            b.wait_for(chosen, 5.0)
+            b.wait_for(chosen, 10.0)
             break
         except AssertionError:
             if attempt == 4:
                 raise
     b.click("button", "Home")
+    b.wait_for(f"document.body.innerText.includes('home {joint}')")  # the page's log line
+    assert f"home {joint} REFUSED" not in b.text()
     j = JOINT_INDEX[joint]
-    s = page.daemon.wait_until(lambda s: s["zeroed"][j], 10.0)
+    s = page.daemon.wait_until(lambda s: s["zeroed"][j], 20.0)
     assert int(np.sum(s["zeroed"])) == 1
     b.wait_for(f"(() => {{ const r = {ROW_OF.format(name=joint)}; "
                "return r.cells[5].textContent.trim() === 'OK'; })()")
@@ -282,7 +284,7 @@ def refusal_shown_and_nothing_sent(page: Page, line: str, *shown: str) -> None:
         b.click("button", "Run")
         for text in shown:
             b.wait_for(f"document.body.innerText.includes({text!r})")
-        assert b.evaluate("document.querySelector('.q-notification') !== null")
+        b.wait_for("document.querySelector('.q-notification') !== null", 5.0)
         after = ref.read_latest()
         assert after is None if before is None else int(after["seq"]) == int(before["seq"])
     finally:
@@ -347,7 +349,7 @@ def test_the_neck_keys_turn_the_head_and_stop_at_its_limit(page, tmp_path):
 
     for n, goal in enumerate((1.0, 2.0, 3.0), 1):  # one key at a time: the head settles
         b.press("q")
-        b.wait_for(f"document.body.innerText.split('NKY goal').length > {n}", 15.0)
+        b.wait_for(f"document.body.innerText.split('NKY goal').length > {n}", 30.0)
         d.wait_until(settled(goal), 15.0)
     b.press("q")
     b.wait_for(f"document.body.innerText.includes('NKY goal {hi:+.3f} rad  at its limit')")

@@ -48,6 +48,14 @@ RATE_RANGE_HZ = (1.0, 20.0)
 #: Allowed head camera rates [Hz]: each frame is a MuJoCo render on a shared CPU.
 CAMERA_FPS_RANGE_HZ = (1.0, 10.0)
 PORT_RANGE = (1, 65535)
+#: How long the server keeps a browser's page (its chosen joint, its log) while the
+#: browser's connection is down [s]; past it the browser reloads a new page. NiceGUI's 3 s
+#: default rebuilt pages on a busy operator computer and lost the operator's choices.
+RECONNECT_TIMEOUT_S = 30.0
+#: Messages the server keeps to resend after a dropped connection. At the 20 Hz page rate
+#: (about 4 messages a refresh) NiceGUI's 1000 covered 12 s: a slow browser that had not
+#: acknowledged them got a reloaded page instead.
+MESSAGE_HISTORY = 10_000
 
 
 def _in_range(flag: str, text: str, allowed: tuple[float, float], unit: str) -> float:
@@ -139,7 +147,8 @@ def _run(args: argparse.Namespace) -> int:
     print(f"hubo-init: http://{args.host}:{int(port)}/ for {link.where}, "
           f"{rate_hz:g} Hz, camera {args.camera}", file=sys.stderr, flush=True)
     ui.run(lambda: build_page(station), host=args.host, port=int(port), title="hubo-init",
-           reload=False, show=False, show_welcome_message=False, favicon="🪜")
+           reload=False, show=False, show_welcome_message=False, favicon="🪜",
+           reconnect_timeout=RECONNECT_TIMEOUT_S, message_history_length=MESSAGE_HISTORY)
     return 0
 
 
