@@ -325,23 +325,20 @@ def test_once_off_the_floor_the_body_takes_the_ladders_placement(reach):
     assert np.allclose(layer._body_shift_m(hold), on_floor)
 
 
-def test_on_the_ladder_the_body_is_trimmed_back_to_the_held_rails(reach):
-    """Once the ladder alone carries the robot, the holding hands' encoders measure how
-    far the body stands towards the ladder from the plan's posture relative to the rails
-    (a creeping foot, arms pulling on their grips). Every holding limb, a stance foot
-    with no correction of its own included, then moves the body back, horizontally,
-    within the bound; an error the body has already taken out leaves the trim where it
-    is. A grasp made on the ladder reads the error against the hands already holding."""
+def _layer_on_the_held_rails(reach, config: MotionConfig):
+    """A layer on the reach's last line with both hands holding grasps made from the floor
+    and the ladder alone carrying the body, at the plan's attitude; and
+    ``sensed_with_body_at(offset_m, left_seat_m)``: the encoders with both hands on their
+    holds (the left one seated ``left_seat_m`` from it) and the body ``offset_m`` away."""
     from execute.motion.estimator import BodyEstimate
-    from execute.motion.events import MotionEventKind
-    from execute.motion.layer import BODY_TRIM_GAIN, MotionLayer
+    from execute.motion.layer import MotionLayer
     from execute.play.player import PlayerOptions, TrajectoryPlayer
 
     _path, traj, sc, ladder = reach
     seg = sc.segments[-1]
     assert {"left_hand", "right_hand", "left_foot"} <= set(seg.holds)
     layer = MotionLayer(TrajectoryPlayer(traj, PlayerOptions(rate_hz=int(sc.rate_hz))),
-                        traj, sc, ladder, config=MotionConfig(max_body_trim_m=0.03))
+                        traj, sc, ladder, config=config)
     layer._line = line = seg.first_line - 1
     T_world_pelvis = np.eye(4)  # the body at the plan's attitude
     T_world_pelvis[:3, :3] = layer._planned_pelvis_rotation()
@@ -353,16 +350,32 @@ def test_on_the_ladder_the_body_is_trimmed_back_to_the_held_rails(reach):
                          for side in ("left", "right")}
     for side in ("left", "right"):  # grasps made from the floor
         layer._seat_grasp(side, f"rail_{side}", on_floor=True)
-    layer._follow_holds(seg)  # the holds as they are taken: nothing to realise yet
-    assert "left_foot" not in layer._offsets
 
     def sensed_with_body_at(offset_m, left_seat_m=(0.0, 0.0, 0.0)):
-        """The encoders with both hands on their holds (the left one seated
-        ``left_seat_m`` from it) and the body ``offset_m`` away."""
         q = traj[line].copy()
         for side, seat in (("left", np.asarray(left_seat_m)), ("right", np.zeros(3))):
             q += layer._limb_shift_dq(f"{side}_hand", line, seat - offset_m, np.eye(3))[0]
         return q
+
+    return layer, seg, sensed_with_body_at
+
+
+def test_on_the_ladder_the_body_is_trimmed_back_to_the_held_rails(reach):
+    """Once the ladder alone carries the robot, the holding hands' encoders measure how
+    far the body stands towards the ladder from the plan's posture relative to the rails
+    (a creeping foot, arms pulling on their grips). Every holding limb, a stance foot
+    with no correction of its own included, then moves the body back, horizontally,
+    within the bound; an error the body has already taken out leaves the trim where it
+    is. A grasp made on the ladder reads the error against the hands already holding."""
+    from execute.motion.events import MotionEventKind
+    from execute.motion.layer import BODY_TRIM_GAIN
+
+    _path, traj, _sc, _ladder = reach
+    layer, seg, sensed_with_body_at = _layer_on_the_held_rails(
+        reach, MotionConfig(max_body_trim_m=0.03))
+    layer._follow_holds(seg)  # the holds as they are taken: nothing to realise yet
+    assert "left_foot" not in layer._offsets
+    line = layer._line
 
     towards_ladder = layer.geometry.R_world_ladder[:, 0]  # horizontal
     layer._pos_rad = sensed_with_body_at(0.02 * towards_ladder)  # pulled 2 cm towards it
@@ -396,6 +409,32 @@ def test_on_the_ladder_the_body_is_trimmed_back_to_the_held_rails(reach):
     assert abs(layer._body_trim_m) == pytest.approx(layer.config.max_body_trim_m)
 
 
+def test_on_the_ladder_a_foot_is_aimed_against_the_body_offset_the_hands_read(reach):
+    """With the foot aim on and the ladder alone carrying the robot, a foot's reach is
+    aimed against the body's offset from the plan's posture relative to the held rails,
+    horizontally and within the bound; the body itself is not trimmed. Off by default,
+    on the floor, or within the reading's deadband: no aim."""
+    from execute.motion.layer import FOOT_AIM_DEADBAND_M
+
+    layer, _seg, sensed_with_body_at = _layer_on_the_held_rails(
+        reach, MotionConfig(max_foot_aim_m=0.03))
+    towards_ladder = layer.geometry.R_world_ladder[:, 0]  # horizontal
+    layer._pos_rad = sensed_with_body_at(0.02 * towards_ladder)  # 2 cm towards it
+    assert np.allclose(layer._foot_aim_m(), -0.02 * towards_ladder, atol=1e-3)
+    layer._trim_body()
+    assert layer._body_trim_m == 0.0  # the body stays
+    layer._pos_rad = sensed_with_body_at(-0.08 * towards_ladder)  # beyond the bound
+    assert np.allclose(layer._foot_aim_m(), 0.03 * towards_ladder, atol=1e-6)
+    layer._pos_rad = sensed_with_body_at(0.5 * FOOT_AIM_DEADBAND_M * towards_ladder)
+    assert not layer._foot_aim_m().any()
+    layer._pos_rad = sensed_with_body_at(0.02 * towards_ladder)
+    layer._body_on_ladder = False  # a foot on the floor: the plan's posture over it
+    assert not layer._foot_aim_m().any()
+    off, _seg, sensed_off = _layer_on_the_held_rails(reach, MotionConfig())
+    off._pos_rad = sensed_off(0.02 * towards_ladder)
+    assert not off._foot_aim_m().any()
+
+
 @pytest.mark.parametrize("field,value", [("max_reach_correction_m", 0.2),
                                          ("grasp_retries", -1),
                                          ("max_reach_correction_rad", 1.0),
@@ -403,7 +442,8 @@ def test_on_the_ladder_the_body_is_trimmed_back_to_the_held_rails(reach):
                                          ("landing_load_n", 0.0),
                                          ("strike_load_n", 5.0),
                                          ("strike_backoff_m", 0.08),
-                                         ("max_body_trim_m", 0.08)])
+                                         ("max_body_trim_m", 0.08),
+                                         ("max_foot_aim_m", 0.08)])
 def test_unsafe_settings_are_refused(field, value):
     with pytest.raises(MotionConfigError) as exc:
         MotionConfig(**{field: value})

@@ -69,6 +69,7 @@ _RANGES = {
     "hand_strike_load_n": (5.0, 100.0),
     "replan_beyond_m": (0.0, 0.2),
     "max_body_trim_m": (0.0, 0.05),
+    "max_foot_aim_m": (0.0, 0.05),
 }
 
 
@@ -128,6 +129,14 @@ class MotionConfig:
             A stance foot creeping on its rung and compliant arms pulling on their grips
             move the body 1–3 cm towards the ladder over a climb, where the plan keeps
             its shins 1–2.5 cm clear of the rungs.
+        max_foot_aim_m: once the ladder alone carries the robot, each foot's reach to a
+            rung is aimed against the body's offset from the plan's posture relative to
+            the held rails (horizontally, towards the ladder, as the holding arms'
+            encoders read it; `max_body_trim_m`'s reading), by at most this [m]; the
+            body itself stays. 0: never (the default; experimental,
+            docs/decisions/foot-aim.md). A foot placed relative to a body that stands
+            on already-offset feet lands offset again: on `ship` the feet drift 0.5 cm
+            towards the ladder per rung.
         estimator: the state estimator's thresholds.
     """
 
@@ -156,6 +165,7 @@ class MotionConfig:
     hand_strike_load_n: float = 15.0
     replan_beyond_m: float = 0.0
     max_body_trim_m: float = 0.0
+    max_foot_aim_m: float = 0.0
     estimator: EstimatorConfig = field(default_factory=EstimatorConfig)
 
     def __post_init__(self) -> None:
@@ -205,6 +215,12 @@ def add_motion_arguments(parser: argparse.ArgumentParser) -> None:
                              "posture relative to the rails its hands hold [m], "
                              + within("max_body_trim_m") + ", 0 never (experimental: "
                              "docs/decisions/body-trim.md)")
+    parser.add_argument("--max-foot-aim", type=float, default=cfg.max_foot_aim_m,
+                        metavar="M",
+                        help="closed loop: on the ladder, largest shift of a foot's reach "
+                             "against the body's offset from the plan's posture relative "
+                             "to the held rails [m], " + within("max_foot_aim_m")
+                             + ", 0 never (experimental: docs/decisions/foot-aim.md)")
 
 
 def motion_config_from_args(args: argparse.Namespace) -> MotionConfig:
@@ -217,4 +233,5 @@ def motion_config_from_args(args: argparse.Namespace) -> MotionConfig:
                         grasp_retries=args.grasp_retries,
                         holding_arm_stiffness=args.holding_arm_stiffness,
                         replan_beyond_m=args.replan_beyond,
-                        max_body_trim_m=args.max_body_trim)
+                        max_body_trim_m=args.max_body_trim,
+                        max_foot_aim_m=args.max_foot_aim)

@@ -66,7 +66,10 @@ hubo-motion-rt and the thesis's operator did (thesis §4.3.4, §6.2):
   the body stands towards the ladder from the plan's posture relative to the rails (a
   creeping stance foot, compliant arms pulling on their grips); every holding limb's
   references then move the body back, horizontally, within ``max_body_trim_m``
-  (`_trim_body`).
+  (`_trim_body`);
+- **the feet aimed from the rails**: once the ladder alone carries the robot, each foot's
+  reach to a rung is aimed against the body's offset that the holding hands read, within
+  ``max_foot_aim_m``; the body itself stays (`_foot_aim_m`).
 
 Its only input is the daemon's state struct (`execute.motion.sensed_state`). It writes
 references, modes and feed-forward, the same things the open-loop player writes.
@@ -121,6 +124,10 @@ SEARCH_PATTERN = ((1, 0), (0, 1), (0, -1), (-1, 0), (1, 1), (1, -1), (-1, 1), (-
 #: odometry drift, a hand settled off the axis within the grip) is below it, and the grip
 #: and the feet tolerate it.
 MIN_CORRECTION_M = 0.01
+#: A body offset the foot aim leaves alone [m]: the hands read the body's place within
+#: 0.6 cm of MuJoCo's (median 0.2 cm, DRC seed 1, 2026-11-29); `ship`'s feet drift
+#: 0.5 cm a rung, under `MIN_CORRECTION_M`.
+FOOT_AIM_DEADBAND_M = 0.005
 #: The planned swing's highest point is looked for on every this many lines.
 APEX_STRIDE_LINES = 20
 #: A backing-off foot also moves down by this share of its back-off, off the underside it
@@ -551,13 +558,34 @@ class MotionLayer:
         2 cm from it (1.8 cm between the two hands' readings on DRC seed 1, 2026-11-29):
         its reading is taken against the body error that the hands already holding read
         at that moment, so that the error is carried from grasp to grasp."""
-        if not self._trims_body:
+        if not self._reads_body:
             return
         if on_floor:
             self._grasp_seat_m[side] = 0.0
             return
         body = self._body_error_m(but=side)
         self._grasp_seat_m[side] = self._hand_readings_m({side: rail})[side] - (body or 0.0)
+
+    @property
+    def _reads_body(self) -> bool:
+        """The body's offset from the held rails is read (`_body_error_m`): the body trim
+        or the foot aim is on."""
+        return self._trims_body or self.config.max_foot_aim_m > 0.0
+
+    def _foot_aim_m(self) -> np.ndarray:
+        """Where a foot's reach to a rung is aimed, on top of the ladder estimate's shift,
+        once the ladder alone carries the robot [m]: against the body's offset from the
+        plan's posture relative to the held rails (`_body_error_m`), horizontally, within
+        ``max_foot_aim_m``. The reach is relative to the body; a body that stands
+        towards the ladder on offset feet would otherwise set the next foot as far off
+        again. Zero with the aim off, on the floor, or with no hand holding."""
+        cap = self.config.max_foot_aim_m
+        if cap <= 0.0 or not self._body_on_ladder:
+            return np.zeros(3)
+        error = self._body_error_m()
+        if error is None or abs(error) < FOOT_AIM_DEADBAND_M:
+            return np.zeros(3)
+        return -float(np.clip(error, -cap, cap)) * self._towards_ladder
 
     @property
     def _trims_body(self) -> bool:
@@ -639,6 +667,8 @@ class MotionLayer:
             if seg.phase != "limb" or not self._on_ladder(hold.target):
                 continue
             shift = self._ladder_shift(np.asarray(hold.position_m))
+            if limb.endswith("_foot"):
+                shift = shift + self._foot_aim_m()
             if not shift.any():
                 if limb not in self._offsets:
                     continue
