@@ -402,8 +402,8 @@ def test_on_the_ladder_the_body_is_trimmed_back_to_the_held_rails(reach):
     layer._pos_rad = sensed_with_body_at(0.01 * towards_ladder,
                                          0.015 * layer.geometry.rung_line_normal)
     layer._seat_grasp("left", "rail_left", on_floor=False)
-    assert layer._body_error_m() == pytest.approx(0.01, abs=1e-3)
-    assert abs(layer._hand_readings_m({"left": "rail_left"})["left"] - 0.01) > 0.01
+    assert layer._body_error_m()[0] == pytest.approx(0.01, abs=1e-3)
+    assert abs(layer._hand_readings_m({"left": "rail_left"})["left"][0] - 0.01) > 0.01
     layer._pos_rad = sensed_with_body_at(0.08 * towards_ladder)  # beyond the bound
     layer._trim_body()
     assert abs(layer._body_trim_m) == pytest.approx(layer.config.max_body_trim_m)
@@ -419,8 +419,12 @@ def test_on_the_ladder_a_foot_is_aimed_against_the_body_offset_the_hands_read(re
     layer, _seg, sensed_with_body_at = _layer_on_the_held_rails(
         reach, MotionConfig(max_foot_aim_m=0.03))
     towards_ladder = layer.geometry.R_world_ladder[:, 0]  # horizontal
+    along_rungs = layer.geometry.R_world_ladder[:, 1]
     layer._pos_rad = sensed_with_body_at(0.02 * towards_ladder)  # 2 cm towards it
     assert np.allclose(layer._foot_aim_m(), -0.02 * towards_ladder, atol=1e-3)
+    offset = 0.01 * towards_ladder - 0.015 * along_rungs  # and 1.5 cm to its right
+    layer._pos_rad = sensed_with_body_at(offset)
+    assert np.allclose(layer._foot_aim_m(), -offset, atol=1e-3)
     layer._trim_body()
     assert layer._body_trim_m == 0.0  # the body stays
     layer._pos_rad = sensed_with_body_at(-0.08 * towards_ladder)  # beyond the bound

@@ -278,9 +278,11 @@ class MotionLayer:
         #: placement, to stand in the plan's posture relative to the held rails [m]
         #: (`_trim_body`)
         self._body_trim_m = 0.0
-        #: side → what its grasp's own seat adds to the body error it reads [m]
-        #: (`_hand_readings_m`, `_seat_grasp`)
-        self._grasp_seat_m: dict[str, float] = {}
+        #: along the rungs (world): the lateral part of the body error
+        self._along_rungs = self.geometry.R_world_ladder[:, 1].copy()
+        #: side → what its grasp's own seat adds to the body error it reads, towards the
+        #: ladder and along the rungs [m] (`_hand_readings_m`, `_seat_grasp`)
+        self._grasp_seat_m: dict[str, np.ndarray] = {}
         self._arrived: set[tuple[int, str]] = set()
         #: side → (first compliant line, grasp's first line, grasp segment) of each reach
         #: whose arm the schedule turns compliant in the air before its grasp, 0-based
@@ -495,11 +497,11 @@ class MotionLayer:
                 R_wp @ Rotation.from_rotvec(turn).as_matrix() @ R_wp.T
                 @ rot_z(self._body_yaw_rad()))
 
-    def _hand_readings_m(self, rails: dict[str, str]) -> dict[str, float]:
+    def _hand_readings_m(self, rails: dict[str, str]) -> dict[str, np.ndarray]:
         """side → how far the body stands from the plan's posture relative to its rail
-        (``rails``: side → rail), horizontally towards the ladder, as that hand on it
-        reads it [m]; the palms of all the hands from one forward kinematics each of the
-        plan's line and of the encoders.
+        (``rails``: side → rail), horizontally towards the ladder and along the rungs, as
+        that hand on it reads it [m]; the palms of all the hands from one forward
+        kinematics each of the plan's line and of the encoders.
 
         The plan's palm (the grip centre, on the rail's axis) from its pelvis, turned
         by the plan's attitude of the pelvis (`_planned_pelvis_rotation`), against the
@@ -507,7 +509,8 @@ class MotionLayer:
         body's offset across the rail; along it a grip may slide. Read as a horizontal
         offset (a stance foot creeps along its tread; the legs, near straight, set the
         height), it is the across part's component towards the ladder over that
-        direction's share across the rail. No odometry enters. It includes where the
+        direction's share across the rail. Along the rungs the rail's axis has no share:
+        that component is the offset's own. No odometry enters. It includes where the
         grasp seated on its rail against where the ladder estimate has the hold
         (`_seat_grasp`)."""
         palms = tuple(f"{side[0].upper()}_palm" for side in rails)
@@ -521,7 +524,8 @@ class MotionLayer:
             offset = R_plan @ planned[palm][:3, 3] - R_est @ sensed[palm][:3, 3]
             axis = self._rail_direction(rail)
             across = offset - (offset @ axis) * axis
-            out[side] = float(n @ across) / (1.0 - float(n @ axis) ** 2)
+            out[side] = np.array([float(n @ across) / (1.0 - float(n @ axis) ** 2),
+                                  float(self._along_rungs @ across)])
         return out
 
     def _planned_pelvis_rotation(self) -> np.ndarray:
@@ -538,20 +542,20 @@ class MotionLayer:
                                                    f"{foot[0].upper()}_sole")[:3, :3]
         return rot_z(self._body_yaw_rad()) @ R_world_sole @ R_pelvis_sole.T
 
-    def _body_error_m(self, but: str = "") -> float | None:
+    def _body_error_m(self, but: str = "") -> np.ndarray | None:
         """How far the body stands from the plan's posture relative to the rails,
-        horizontally towards the ladder [m]: the mean over the hands that hold verified
-        grasps (`_held_rails`), other than ``but``, of what each reads less its grasp's
-        seat; None without one."""
+        horizontally towards the ladder and along the rungs [m]: the mean over the hands
+        that hold verified grasps (`_held_rails`), other than ``but``, of what each reads
+        less its grasp's seat; None without one."""
         held = {side: rail for side, (rail, _planned_m) in sorted(self._held_rails.items())
                 if side != but and side in self._grasp_seat_m}
         if not held:
             return None
         readings = self._hand_readings_m(held)
-        return float(np.mean([readings[side] - self._grasp_seat_m[side] for side in held]))
+        return np.mean([readings[side] - self._grasp_seat_m[side] for side in held], axis=0)
 
     def _seat_grasp(self, side: str, rail: str, on_floor: bool) -> None:
-        """With the body trim on, record what a newly verified grasp's seat adds to the
+        """With the body read (`_reads_body`), record what a newly verified grasp's seat adds to the
         body error its hand reads (`_hand_readings_m`). A grasp made from the floor seats
         where the ladder estimate has its rail (the estimate is fitted to the palms):
         nothing. A grasp on the ladder seats within the fingers' reach of its hold, up to
@@ -561,10 +565,11 @@ class MotionLayer:
         if not self._reads_body:
             return
         if on_floor:
-            self._grasp_seat_m[side] = 0.0
+            self._grasp_seat_m[side] = np.zeros(2)
             return
         body = self._body_error_m(but=side)
-        self._grasp_seat_m[side] = self._hand_readings_m({side: rail})[side] - (body or 0.0)
+        self._grasp_seat_m[side] = (self._hand_readings_m({side: rail})[side]
+                                    - (np.zeros(2) if body is None else body))
 
     @property
     def _reads_body(self) -> bool:
@@ -576,16 +581,20 @@ class MotionLayer:
         """Where a foot's reach to a rung is aimed, on top of the ladder estimate's shift,
         once the ladder alone carries the robot [m]: against the body's offset from the
         plan's posture relative to the held rails (`_body_error_m`), horizontally, within
-        ``max_foot_aim_m``. The reach is relative to the body; a body that stands
-        towards the ladder on offset feet would otherwise set the next foot as far off
-        again. Zero with the aim off, on the floor, or with no hand holding."""
+        ``max_foot_aim_m``. The reach is relative to the body; a body that stands off
+        on offset feet would otherwise set the next foot as far off again. Zero with the
+        aim off, on the floor, or with no hand holding."""
         cap = self.config.max_foot_aim_m
         if cap <= 0.0 or not self._body_on_ladder:
             return np.zeros(3)
         error = self._body_error_m()
-        if error is None or abs(error) < FOOT_AIM_DEADBAND_M:
+        if error is None:
             return np.zeros(3)
-        return -float(np.clip(error, -cap, cap)) * self._towards_ladder
+        size = float(np.linalg.norm(error))
+        if size < FOOT_AIM_DEADBAND_M:
+            return np.zeros(3)
+        error = error * min(1.0, cap / size)
+        return -(error[0] * self._towards_ladder + error[1] * self._along_rungs)
 
     @property
     def _trims_body(self) -> bool:
@@ -607,9 +616,10 @@ class MotionLayer:
             self._body_trim_m = 0.0
             return
         cap = self.config.max_body_trim_m
-        error = self._body_error_m()
-        if error is None or abs(error) < BODY_TRIM_DEADBAND_M:
+        body_error = self._body_error_m()
+        if body_error is None or abs(body_error[0]) < BODY_TRIM_DEADBAND_M:
             return
+        error = float(body_error[0])  # towards the ladder
         trim = float(np.clip(self._body_trim_m - BODY_TRIM_GAIN * error, -cap, cap))
         if trim == self._body_trim_m:
             return  # at its bound
