@@ -131,9 +131,9 @@ class MotionConfig:
             its shins 1–2.5 cm clear of the rungs.
         max_foot_aim_m: once the ladder alone carries the robot, each foot's reach to a
             rung is aimed against the body's offset from the plan's posture relative to
-            the held rails (horizontally, towards the ladder, as the holding arms'
-            encoders read it; `max_body_trim_m`'s reading), by at most this [m]; the
-            body itself stays. 0: never (the default; experimental,
+            the held rails (horizontally, towards the ladder and along the rungs, as the
+            holding arms' encoders read it; `max_body_trim_m`'s reading), by at most this
+            [m]; the body itself stays. 0: never (the default; experimental,
             docs/decisions/foot-aim.md). A foot placed relative to a body that stands
             on already-offset feet lands offset again: on `ship` the feet drift 0.5 cm
             towards the ladder per rung.

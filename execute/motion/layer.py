@@ -449,9 +449,10 @@ class MotionLayer:
         """The yaw of the body's own placement (`_body_shift_m`) [rad]."""
         return self.ladder.yaw_rad if self._body_on_ladder else 0.0
 
-    def _bounded(self, shift_m: np.ndarray) -> np.ndarray:
+    def _bounded(self, shift_m: np.ndarray, cap_m: float | None = None) -> np.ndarray:
+        """``shift_m`` shortened to ``cap_m`` (default ``max_reach_correction_m``) [m]."""
+        cap = self.config.max_reach_correction_m if cap_m is None else cap_m
         length = float(np.linalg.norm(shift_m))
-        cap = self.config.max_reach_correction_m
         return shift_m if length <= cap else shift_m * (cap / length)
 
     def _observe_held_rails(self, seg: Segment) -> None:
@@ -567,9 +568,9 @@ class MotionLayer:
         if on_floor:
             self._grasp_seat_m[side] = np.zeros(2)
             return
+        seat = self._hand_readings_m({side: rail})[side]
         body = self._body_error_m(but=side)
-        self._grasp_seat_m[side] = (self._hand_readings_m({side: rail})[side]
-                                    - (np.zeros(2) if body is None else body))
+        self._grasp_seat_m[side] = seat if body is None else seat - body
 
     @property
     def _reads_body(self) -> bool:
@@ -588,13 +589,10 @@ class MotionLayer:
         if cap <= 0.0 or not self._body_on_ladder:
             return np.zeros(3)
         error = self._body_error_m()
-        if error is None:
+        if error is None or float(np.linalg.norm(error)) < FOOT_AIM_DEADBAND_M:
             return np.zeros(3)
-        size = float(np.linalg.norm(error))
-        if size < FOOT_AIM_DEADBAND_M:
-            return np.zeros(3)
-        error = error * min(1.0, cap / size)
-        return -(error[0] * self._towards_ladder + error[1] * self._along_rungs)
+        return self._bounded(-(error[0] * self._towards_ladder
+                               + error[1] * self._along_rungs), cap)
 
     @property
     def _trims_body(self) -> bool:
