@@ -248,7 +248,8 @@ def test_a_missed_grasp_searches_where_the_holding_hands_found_the_rails(reach):
     layer.player.pause(0.0)  # the player waits while a grasp is verified
     sense(np.zeros(3))
     for side in ("left", "right"):
-        layer._grasp_verified(_Regrasp(side, grasp, f"rail_{side}", planned[side], "verify", 0.0))
+        layer._grasp_verified(_Regrasp(side, grasp, f"rail_{side}", planned[side], "verify", 0.0),
+                              0.0, 0.0)
     creep = np.array([-0.03, 0.0, 0.0])  # the feet crept 3 cm towards the ladder
     sense(creep)
     layer._enter_segment(grasp + 1)
@@ -525,6 +526,22 @@ def test_a_misplaced_ladder_is_re_grasped_from_sensors(reach):
     log = closed.log
     re_reach = (log.time_s > missed["time_s"] + 0.01) & (log.time_s < verified["time_s"] - 0.01)
     assert re_reach.any() and not log.pwm[re_reach][:, arm].any()
+
+
+def test_a_grasp_measures_its_rail_once_the_palm_stands_still_in_the_grip(reach):
+    """The ladder 1.2 cm to the side of the plan's, within the grip's capture: the fingers
+    stop on the rails before the grip has drawn the palms onto them. The grasps are
+    verified once the palms stand still, and the ladder estimate then has the shift to
+    within 3 mm (read when the fingers stopped, a palm was 5 mm further)."""
+    _path, traj, sc, ladder = reach
+    run = simulate(traj, sc, ladder, SimulationOptions(
+        placement=PlacementError(0.0, 0.012, 0.0), record_qpos=False))
+    assert run.verdict.climbed, run.verdict
+    verified = [e for e in run.motion["events"] if e["kind"] == "grasp verified"]
+    assert len(verified) == 2
+    assert all("still in the grip" in e["cause"] for e in verified)
+    shift_m = run.motion["ladder_shift_m"]
+    assert abs(shift_m[1] - 0.012) < 0.003 and abs(shift_m[0]) < 0.003
 
 
 def test_a_compliant_arm_short_of_its_hold_finishes_the_reach_stiff(reach):

@@ -54,6 +54,7 @@ _RANGES = {
     "shift_s": (0.2, 5.0),
     "close_s": (0.2, 5.0),
     "verify_timeout_s": (0.1, 5.0),
+    "seat_timeout_s": (0.0, 5.0),
     "arrival_tolerance_m": (0.002, 0.05),
     "arrival_timeout_s": (0.0, 10.0),
     "aim_tolerance_m": (0.005, 0.05),
@@ -90,6 +91,9 @@ class MotionConfig:
         search_step_m: spacing of the re-reach pattern around the target [m].
         open_s, shift_s, close_s: durations of a re-reach's opening, move and closing [s].
         verify_timeout_s: how long a closed hand may take to read on-rail or empty [s].
+        seat_timeout_s: the longest wait, once the fingers read on-rail, for the palm to
+            stand still in the grip before the grasp is taken as verified and its palm as
+            where the rail is [s] (`execute.motion.layer.SEATED_SPEED_M_S`).
         arrival_tolerance_m: how close the palm must come to where its reference puts it
             before the hand closes [m].
         arrival_timeout_s: the longest wait for that [s].
@@ -150,6 +154,7 @@ class MotionConfig:
     shift_s: float = 1.5
     close_s: float = 1.0
     verify_timeout_s: float = 1.5
+    seat_timeout_s: float = 1.5
     arrival_tolerance_m: float = 0.01
     arrival_timeout_s: float = 4.0
     aim_tolerance_m: float = 0.015

@@ -128,6 +128,14 @@ MIN_CORRECTION_M = 0.01
 #: 0.6 cm of MuJoCo's (median 0.2 cm, DRC seed 1, 2026-11-29); `ship`'s feet drift
 #: 0.5 cm a rung, under `MIN_CORRECTION_M`.
 FOOT_AIM_DEADBAND_M = 0.005
+#: A palm whose estimate moves slower than this [m/s], over `SEAT_WINDOW_S` of the daemon's
+#: time, stands still in its grip: the grasp is then seated and its palm read as where the
+#: rail is. Fingers read on-rail as soon as they stop on it; the grip then draws the rail
+#: into its middle and a compliant arm gives way, over about a second (a ladder 1.2 cm off
+#: the plan's: the palm read 1.7 cm when the fingers stopped, 1.19 cm once still; under
+#: CPU load the first reading was 0.1 cm, 2026-11-29).
+SEATED_SPEED_M_S = 0.003
+SEAT_WINDOW_S = 0.1
 #: The planned swing's highest point is looked for on every this many lines.
 APEX_STRIDE_LINES = 20
 #: A backing-off foot also moves down by this share of its back-off, off the underside it
@@ -183,10 +191,12 @@ class _Regrasp:
     segment: int
     rail: str
     planned_m: np.ndarray
-    phase: str  # "catch_up", "retarget", "arrive", "verify", "open", "shift", "close"
+    phase: str  # "catch_up", "retarget", "arrive", "verify", "open", "shift", "close", "seat"
     since_s: float
     tries: int = 0
     candidates: list = dataclasses.field(default_factory=list)  # re-reach shifts [m]
+    seat_time_s: float = 0.0  # while seating: the daemon time of the last palm sample [s]
+    seat_palm_m: np.ndarray | None = None  # and that palm estimate [m]
 
 
 @dataclass
@@ -874,11 +884,14 @@ class MotionLayer:
                     return
                 self._regrasp = None
                 self.player.resume(now)
+        elif g.phase == "seat":
+            self._update_seat(g, s, elapsed)
         elif g.phase in ("verify", "close"):
             reading = read_grasp(g.side, s.pos_rad, s.vel_rad_s, self.geometry.spec.rail_radius_m)
             waited = cfg.verify_timeout_s + (cfg.close_s if g.phase == "close" else 0.0)
             if reading is GraspReading.ON_RAIL and (g.phase == "verify" or elapsed >= cfg.close_s):
-                self._grasp_verified(g)
+                g.phase, g.since_s = "seat", now
+                g.seat_time_s, g.seat_palm_m = s.time_s, self.estimate.palm_m[g.side].copy()
                 return
             if reading is GraspReading.CLOSING and elapsed < waited:
                 return
@@ -912,6 +925,24 @@ class MotionLayer:
         elif g.phase == "shift" and elapsed >= cfg.shift_s:
             self._open_fingers.discard(g.side)
             g.phase, g.since_s = "close", now
+
+    def _update_seat(self, g: _Regrasp, s: SensedState, elapsed_s: float) -> None:
+        """Fingers that read on-rail: the grasp is verified once the palm stands still in
+        the grip (`SEATED_SPEED_M_S`), or after ``seat_timeout_s``; fingers that close on
+        past the rail meanwhile lost it, and are read again as a grasp being verified."""
+        reading = read_grasp(g.side, s.pos_rad, s.vel_rad_s, self.geometry.spec.rail_radius_m)
+        if reading is GraspReading.EMPTY:
+            g.phase = "verify"
+            return
+        window_s = s.time_s - g.seat_time_s
+        if window_s < SEAT_WINDOW_S:
+            return
+        palm = self.estimate.palm_m[g.side]
+        speed_m_s = float(np.linalg.norm(palm - g.seat_palm_m)) / window_s
+        if speed_m_s <= SEATED_SPEED_M_S or elapsed_s >= self.config.seat_timeout_s:
+            self._grasp_verified(g, elapsed_s, speed_m_s)
+            return
+        g.seat_time_s, g.seat_palm_m = s.time_s, palm.copy()
 
     def _stiffen(self, side: str, size_m: float, cause: str) -> None:
         """Hold ``side``'s arm in position mode until its grasp is verified, as the mixed
@@ -947,7 +978,9 @@ class MotionLayer:
             held = blend.end if self._now >= blend.t1 else blend.at(self._now)
             self._offsets[limb] = _Blend(held, held, float(self._line), float(self._line))
 
-    def _grasp_verified(self, g: _Regrasp) -> None:
+    def _grasp_verified(self, g: _Regrasp, seated_s: float, palm_speed_m_s: float) -> None:
+        """The grasp holds (`_update_seat`): its palm, ``seated_s`` [s] after the fingers
+        stopped on the rail and moving at ``palm_speed_m_s`` [m/s], measures the rail."""
         limb = f"{g.side}_hand"
         self._stiff_arms.discard(g.side)  # on the rail: the plan's compliance again
         self._yielded.discard(g.side)
@@ -957,8 +990,11 @@ class MotionLayer:
         off = palm - g.planned_m
         self._event(MotionEventKind.GRASP_VERIFIED, limb, 0.0,
                     f"fingers at {self.estimate.finger_curl_rad[g.side]:.2f} rad on {g.rail}; "
-                    f"palm {np.round(off * 100, 1).tolist()} cm from the planned hold"
-                    + (f" after {g.tries} re-reach{'es' if g.tries != 1 else ''}"
+                    f"palm {np.round(off * 100, 1).tolist()} cm from the planned hold, "
+                    + (f"still in the grip after {seated_s:.2f} s"
+                       if palm_speed_m_s <= SEATED_SPEED_M_S else
+                       f"still moving at {palm_speed_m_s * 100:.1f} cm/s after {seated_s:.2f} s")
+                    + (f"; {g.tries} re-reach{'es' if g.tries != 1 else ''}"
                        if g.tries else ""))
         observed = RailObservation(g.rail, g.planned_m, palm, self._rail_direction(g.rail))
         on_floor = self._feet_on_floor(self.sidecar.segments[g.segment])
