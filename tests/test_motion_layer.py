@@ -544,6 +544,62 @@ def test_a_grasp_measures_its_rail_once_the_palm_stands_still_in_the_grip(reach)
     assert abs(shift_m[1] - 0.012) < 0.003 and abs(shift_m[0]) < 0.003
 
 
+def test_a_grasp_is_verified_once_its_palm_stands_still_and_measures_the_rail_there(reach):
+    """Fingers on the rail while the grip still draws the palm: no grasp is verified
+    while the palm moves faster than `SEATED_SPEED_M_S`; once it stands still the grasp is
+    verified and its palm, there, measures the ladder. Fingers still moving when the seat
+    times out are read afresh, as a grasp being verified."""
+    from execute.motion.estimator import BodyEstimate
+    from execute.motion.layer import SEAT_WINDOW_S, SEATED_SPEED_M_S, MotionLayer, _Regrasp
+    from execute.play.player import PlayerOptions, TrajectoryPlayer
+    from robot.kinematic_tree import finger_contact_curl_rad
+
+    _path, traj, sc, ladder = reach
+    grasp = next(k for k, seg in enumerate(sc.segments) if seg.phase == "grasp")
+    layer = MotionLayer(TrajectoryPlayer(traj, PlayerOptions(rate_hz=int(sc.rate_hz))),
+                        traj, sc, ladder)
+    planned = {side: np.asarray(sc.segments[grasp + 1].holds[f"{side}_hand"].position_m)
+               for side in ("left", "right")}
+    on_rail = np.zeros(NUM_JOINTS)
+    for side in ("left", "right"):
+        on_rail[[JOINT_INDEX[j] for j in FINGER_JOINTS[side]]] = \
+            finger_contact_curl_rad(ladder.rail_radius_m)
+
+    def tick(t_s, palm_m, finger_speed_rad_s=0.0):
+        layer._now = t_s
+        layer.estimate = BodyEstimate(t_s, np.eye(4), np.eye(3), {"left": True, "right": True},
+                                      palm_m, {}, {"left": 0.09, "right": 0.09})
+        vel = np.zeros(NUM_JOINTS)
+        vel[[JOINT_INDEX[j] for j in FINGER_JOINTS["right"]]] = finger_speed_rad_s
+        layer._update_regrasp(SensedState(
+            t_s, on_rail, vel, np.zeros((4, 3)), np.zeros((3, 6)), on_rail,
+            np.zeros(NUM_JOINTS), np.ones(NUM_JOINTS, bool), np.zeros(NUM_JOINTS, bool)))
+
+    layer.player.step(0.0, traj[0])
+    layer.player.pause(0.0)
+    left = planned["left"] + [0.0, 0.010, 0.0]  # the fingers stopped 1 cm off the rail
+    layer._regrasp = _Regrasp("left", grasp, "rail_left", planned["left"], "seat", 0.0,
+                              seat_time_s=0.0, seat_palm_m=left)
+    drawn = left + [0.0, 0.004, 0.0]  # drawn 4 mm further on over a window
+    tick(SEAT_WINDOW_S, {"left": drawn, "right": planned["right"]})
+    assert layer._regrasp is not None and layer._regrasp.phase == "seat"
+    assert not any(e.kind.value == "grasp verified" for e in layer.events)
+    still = drawn + [0.0, 0.5 * SEATED_SPEED_M_S * SEAT_WINDOW_S, 0.0]
+    tick(2 * SEAT_WINDOW_S, {"left": still, "right": planned["right"]})
+    assert layer._regrasp is None
+    verified = [e for e in layer.events if e.kind.value == "grasp verified"]
+    assert len(verified) == 1 and "still in the grip" in verified[0].cause
+    assert layer.ladder.shift_m[1] == pytest.approx(still[1] - planned["left"][1], abs=1e-3)
+
+    layer.player.pause(1.0)
+    layer._regrasp = _Regrasp("right", grasp, "rail_right", planned["right"], "seat", 1.0,
+                              seat_time_s=1.0, seat_palm_m=planned["right"])
+    timeout_s = layer.config.seat_timeout_s
+    tick(1.0 + timeout_s, {"left": still, "right": planned["right"]}, finger_speed_rad_s=1.0)
+    assert layer._regrasp.phase == "verify"  # read afresh: the fingers still move
+    assert len([e for e in layer.events if e.kind.value == "grasp verified"]) == 1
+
+
 def test_a_compliant_arm_short_of_its_hold_finishes_the_reach_stiff(reach):
     """Mixed arms: a PWM arm that cannot carry its palm to within the arrival tolerance
     finishes the reach in position mode, as it moved in the air, and complies again once

@@ -928,8 +928,9 @@ class MotionLayer:
 
     def _update_seat(self, g: _Regrasp, s: SensedState, elapsed_s: float) -> None:
         """Fingers that read on-rail: the grasp is verified once the palm stands still in
-        the grip (`SEATED_SPEED_M_S`), or after ``seat_timeout_s``; fingers that close on
-        past the rail meanwhile lost it, and are read again as a grasp being verified."""
+        the grip (`SEATED_SPEED_M_S`), or after ``seat_timeout_s``, the fingers still
+        reading on-rail. Fingers that close on past the rail lost it, and fingers still
+        moving at the timeout are read afresh, as a grasp being verified."""
         reading = read_grasp(g.side, s.pos_rad, s.vel_rad_s, self.geometry.spec.rail_radius_m)
         if reading is GraspReading.EMPTY:
             g.phase = "verify"
@@ -939,10 +940,12 @@ class MotionLayer:
             return
         palm = self.estimate.palm_m[g.side]
         speed_m_s = float(np.linalg.norm(palm - g.seat_palm_m)) / window_s
-        if speed_m_s <= SEATED_SPEED_M_S or elapsed_s >= self.config.seat_timeout_s:
-            self._grasp_verified(g, elapsed_s, speed_m_s)
-            return
         g.seat_time_s, g.seat_palm_m = s.time_s, palm.copy()
+        timed_out = elapsed_s >= self.config.seat_timeout_s
+        if reading is GraspReading.ON_RAIL and (speed_m_s <= SEATED_SPEED_M_S or timed_out):
+            self._grasp_verified(g, elapsed_s, speed_m_s)
+        elif timed_out:
+            g.phase, g.since_s = "verify", self._now
 
     def _stiffen(self, side: str, size_m: float, cause: str) -> None:
         """Hold ``side``'s arm in position mode until its grasp is verified, as the mixed
