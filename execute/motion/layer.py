@@ -887,7 +887,7 @@ class MotionLayer:
         elif g.phase == "seat":
             self._update_seat(g, s, elapsed)
         elif g.phase in ("verify", "close"):
-            reading = read_grasp(g.side, s.pos_rad, s.vel_rad_s, self.geometry.spec.rail_radius_m)
+            reading = self._grasp_reading(g.side, s)
             waited = cfg.verify_timeout_s + (cfg.close_s if g.phase == "close" else 0.0)
             if reading is GraspReading.ON_RAIL and (g.phase == "verify" or elapsed >= cfg.close_s):
                 g.phase, g.since_s = "seat", now
@@ -926,12 +926,17 @@ class MotionLayer:
             self._open_fingers.discard(g.side)
             g.phase, g.since_s = "close", now
 
+    def _grasp_reading(self, side: str, s: SensedState) -> GraspReading:
+        """What ``side``'s finger encoders say of its grip on this ladder's rails
+        (`read_grasp`)."""
+        return read_grasp(side, s.pos_rad, s.vel_rad_s, self.geometry.spec.rail_radius_m)
+
     def _update_seat(self, g: _Regrasp, s: SensedState, elapsed_s: float) -> None:
         """Fingers that read on-rail: the grasp is verified once the palm stands still in
         the grip (`SEATED_SPEED_M_S`), or after ``seat_timeout_s``, the fingers still
         reading on-rail. Fingers that close on past the rail lost it, and fingers still
         moving at the timeout are read afresh, as a grasp being verified."""
-        reading = read_grasp(g.side, s.pos_rad, s.vel_rad_s, self.geometry.spec.rail_radius_m)
+        reading = self._grasp_reading(g.side, s)
         if reading is GraspReading.EMPTY:
             g.phase = "verify"
             return
