@@ -78,6 +78,14 @@ def _sensor_rows(state: np.ndarray) -> list[dict]:
             for r in sensor_rows(state)]
 
 
+def _show_rows(table, rows: list[dict]) -> None:
+    """Send ``rows`` to the browser only when they differ from the table's: at rest the
+    joints' and sensors' rows read the same refresh after refresh, and resending all 40
+    every refresh kept a browser on a busy machine behind its server."""
+    if table.rows != rows:
+        table.rows = rows
+
+
 def build_page(station: Station) -> None:
     """Lay out one browser's page and start its refresh timers."""
     from nicegui import run, ui
@@ -170,8 +178,8 @@ def build_page(station: Station) -> None:
             return
         summary.set_text(summary_line(reading.state, age_s))
         summary.classes(replace="text-mono")
-        joints.rows = _table_rows(reading.state, reading.ref_mode)
-        sensors.rows = _sensor_rows(reading.state)
+        _show_rows(joints, _table_rows(reading.state, reading.ref_mode))
+        _show_rows(sensors, _sensor_rows(reading.state))
 
     ui.timer(1.0 / station.rate_hz, refresh)
 
