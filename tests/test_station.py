@@ -14,6 +14,7 @@ import subprocess
 import sys
 import time
 import urllib.request
+import warnings
 from contextlib import redirect_stderr
 from pathlib import Path
 
@@ -260,20 +261,49 @@ def choose_joint(b, joint: str) -> None:
     b.wait_for("document.querySelector('.q-menu') === null")  # closed: it covers nothing
 
 
+#: The last lines of the page's log card, for a failure's message.
+LOG_TAIL = ("(() => { const l = document.querySelector('.nicegui-log'); "
+            "return l ? l.innerText.split('\\n').slice(-5).join(' | ') : '(no log)'; })()")
+
+
+def click_until_answered(b, click, answered: str, what: str, attempts: int = 3) -> None:
+    """Call ``click`` (one mouse click on the page) until the JavaScript ``answered`` is
+    true, at most ``attempts`` times, 15 s each.
+
+    Under a loaded test run a click now and then gets no answer at all: no log line, the
+    page not reloaded (S33–S35). Clicking again is what an operator does; each unanswered
+    click is reported as a warning with what the page showed, so that the cause can be
+    found from a run that passed. The last attempt's failure is raised.
+    """
+    missed = []
+    for attempt in range(attempts):
+        b.evaluate(f"window.__clickAttempt = {attempt}")  # gone if the page reloads
+        click()
+        try:
+            b.wait_for(answered, 15.0)
+            break
+        except AssertionError as exc:
+            state = b.evaluate(f"({{attempt: window.__clickAttempt, log: {LOG_TAIL}}})")
+            missed.append(f"{what}: attempt {attempt} unanswered in 15 s; page mark "
+                          f"{state['attempt']} (undefined: reloaded); log: {state['log']}")
+            if attempt == attempts - 1:
+                raise AssertionError("; ".join(missed)) from exc
+    for line in missed:
+        warnings.warn(line, stacklevel=2)
+
+
 def home_one_joint_from_the_page(page: Page, joint: str) -> None:
     """On a page of a daemon with no joint homed: choose ``joint``, click "Home"; the
     daemon's own state channel shows it homed (and no other), then the page does."""
     b = page.browser
     b.wait_for("document.body.innerText.includes('homed 0/40')")
-    for attempt in range(3):  # a click the page never answered (no log line): again
+
+    def choose_and_home() -> None:
         choose_joint(b, joint)
         b.click("button", "Home")
-        try:
-            b.wait_for(f"document.body.innerText.includes('home {joint}')", 15.0)
-            break
-        except AssertionError:
-            if attempt == 2:
-                raise
+
+    click_until_answered(b, choose_and_home,
+                         f"document.body.innerText.includes('home {joint}')", f"Home {joint}")
     assert f"home {joint} REFUSED" not in b.text()
     j = JOINT_INDEX[joint]
     s = page.daemon.wait_until(lambda s: s["zeroed"][j], 20.0)
@@ -289,12 +319,18 @@ def refusal_shown_and_nothing_sent(page: Page, line: str, *shown: str) -> None:
     channel got nothing."""
     b = page.browser
     ref = open_channel("ref", page.daemon.instance)
-    try:
-        before = ref.read_latest()
+
+    def type_and_run() -> None:
         b.click("input[aria-label='command (hubo-console)']")
+        b.evaluate("document.activeElement.select()")  # a retry types over the last try
         b.type_text(line)
         b.click("button", "Run")
-        for text in shown:
+
+    try:
+        before = ref.read_latest()
+        click_until_answered(b, type_and_run,
+                             f"document.body.innerText.includes({shown[0]!r})", f"Run {line!r}")
+        for text in shown[1:]:
             b.wait_for(f"document.body.innerText.includes({text!r})")
         b.wait_for("document.querySelector('.q-notification') !== null", 5.0)
         after = ref.read_latest()
