@@ -37,20 +37,27 @@ def _climbing_arms() -> np.ndarray:
     return q
 
 
-def test_force_torques_are_the_palms_virtual_work(model):
-    """Jᵀf·dq equals f·dp for a small arm motion (the Jacobian, its frame and its sign)."""
+def test_wrench_torques_are_the_palms_virtual_work(model):
+    """Jᵀw·dq equals f·dp + m·dθ for a small arm motion (the Jacobian, its frame and its
+    sign), for a force alone and for a force and a moment."""
+    import pinocchio as pin
+
     q = _climbing_arms()
-    f = np.array([10.0, -20.0, 50.0])
-    tau = model.force_torques(q, np.eye(3), "left_hand", f)
+    f, m = np.array([10.0, -20.0, 50.0]), np.array([3.0, -1.0, 2.0])
     rng = np.random.default_rng(3)
     dq = np.zeros(NUM_JOINTS)
     cols = [JOINT_INDEX[n] for n in ARM_JOINTS["left"]]
     dq[cols] = rng.normal(scale=1e-4, size=len(cols))
-    p0 = model.frame_in_pelvis(q, "L_palm")[:3, 3]
-    p1 = model.frame_in_pelvis(q + dq, "L_palm")[:3, 3]
-    assert tau @ dq == pytest.approx(f @ (p1 - p0), rel=1e-3)
+    T0 = model.frame_in_pelvis(q, "L_palm")
+    T1 = model.frame_in_pelvis(q + dq, "L_palm")
+    dp, dtheta = T1[:3, 3] - T0[:3, 3], pin.log3(T1[:3, :3] @ T0[:3, :3].T)
+    tau = model.wrench_torques(q, np.eye(3), "left_hand", f)
+    assert tau @ dq == pytest.approx(f @ dp, rel=1e-3)
+    tau_m = model.wrench_torques(q, np.eye(3), "left_hand", f, m)
+    assert tau_m @ dq == pytest.approx(f @ dp + m @ dtheta, rel=1e-3)
+    assert abs(m @ dtheta) > 0.1 * abs(f @ dp)  # the moment's share is not lost in rel
     legs = [JOINT_INDEX[n] for n in LEG_JOINTS["left"] + LEG_JOINTS["right"]]
-    assert not tau[legs].any()  # a force at the palm loads the arm's joints only
+    assert not tau_m[legs].any()  # a wrench at the palm loads the arm's joints only
 
 
 def test_the_lift_grows_above_onset_holds_between_and_shrinks_below_release(model):
@@ -161,7 +168,7 @@ def test_the_lift_pulls_each_gripping_hand_the_way_that_unloads_the_joint(model)
                                             f"{side}_hand")
         assert grad @ d > 0.0  # the negative knee torque moves towards zero
         cols = list(model.chains[f"{side}_hand"].columns)
-        push = model.force_torques(q, np.eye(3), f"{side}_hand", 20.0 * d)
+        push = model.wrench_torques(q, np.eye(3), f"{side}_hand", 20.0 * d)
         np.testing.assert_allclose(ff[cols], -push[cols])
     ff_left = relief.feedforward_nm(["left"], q, np.eye(3), hot)
     right = [JOINT_INDEX[n] for n in ARM_JOINTS["right"]]

@@ -448,7 +448,8 @@ def test_on_the_ladder_a_foot_is_aimed_against_the_body_offset_the_hands_read(re
                                          ("strike_load_n", 5.0),
                                          ("strike_backoff_m", 0.08),
                                          ("max_body_trim_m", 0.08),
-                                         ("max_foot_aim_m", 0.08)])
+                                         ("max_foot_aim_m", 0.08),
+                                         ("grip_bending_onset", 0.45)])
 def test_unsafe_settings_are_refused(field, value):
     with pytest.raises(MotionConfigError) as exc:
         MotionConfig(**{field: value})

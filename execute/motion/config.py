@@ -71,6 +71,7 @@ _RANGES = {
     "replan_beyond_m": (0.0, 0.2),
     "max_body_trim_m": (0.0, 0.05),
     "max_foot_aim_m": (0.0, 0.05),
+    "grip_bending_onset": (0.0, 0.39),
 }
 
 
@@ -141,6 +142,13 @@ class MotionConfig:
             docs/decisions/foot-aim.md). A foot placed relative to a body that stands
             on already-offset feet lands offset again: on `ship` the feet drift 0.5 cm
             towards the ladder per rung.
+        grip_bending_onset: share of a closed grip's bending capacity above which its
+            compliant arm's feed-forward asks the rail for the opposite moment, until the
+            bending estimated from the arm's currents is back at this share
+            (`execute.motion.grip_bending_relief`); 0: never [-]. It stays below the
+            leg relief's 0.4, under which a lift that gave way to a bent grip may grow
+            again: at 0.45 a grip held at 0.45 kept the lift off and a knee tripped (DRC
+            seeds 1 and 4 under the harder perturbation, S36).
         estimator: the state estimator's thresholds.
     """
 
@@ -171,6 +179,7 @@ class MotionConfig:
     replan_beyond_m: float = 0.0
     max_body_trim_m: float = 0.0
     max_foot_aim_m: float = 0.0
+    grip_bending_onset: float = 0.35
     estimator: EstimatorConfig = field(default_factory=EstimatorConfig)
 
     def __post_init__(self) -> None:
@@ -226,6 +235,11 @@ def add_motion_arguments(parser: argparse.ArgumentParser) -> None:
                              "against the body's offset from the plan's posture relative "
                              "to the held rails [m], " + within("max_foot_aim_m")
                              + ", 0 never (experimental: docs/decisions/foot-aim.md)")
+    parser.add_argument("--grip-bending-onset", type=float, default=cfg.grip_bending_onset,
+                        metavar="SHARE",
+                        help="closed loop: share of a grip's bending capacity above which "
+                             "the compliant arm holding it takes the excess off by "
+                             "feed-forward, " + within("grip_bending_onset") + ", 0 never")
 
 
 def motion_config_from_args(args: argparse.Namespace) -> MotionConfig:
@@ -239,4 +253,5 @@ def motion_config_from_args(args: argparse.Namespace) -> MotionConfig:
                         holding_arm_stiffness=args.holding_arm_stiffness,
                         replan_beyond_m=args.replan_beyond,
                         max_body_trim_m=args.max_body_trim,
-                        max_foot_aim_m=args.max_foot_aim)
+                        max_foot_aim_m=args.max_foot_aim,
+                        grip_bending_onset=args.grip_bending_onset)

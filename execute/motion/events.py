@@ -20,6 +20,7 @@ class MotionEventKind(enum.Enum):
     ARRIVAL_WAIT = "arrival wait"  #: a hand lagged its reference; the grasp waited for it
     STIFF_REACH = "stiff reach"  #: a compliant arm short of its hold finished in position mode
     LEG_RELIEF = "leg relief"  #: the gripping arms began to lift more: a leg joint neared its limit
+    GRIP_RELIEF = "grip relief"  #: a grip's bending neared its capacity; its arm took it off
     LADDER_ESTIMATE = "ladder estimate"  #: the estimate of the ladder's pose changed
     BODY_TRIM = "body trim"  #: the body moved back to the plan's posture relative to the rails
     FOOT_LANDING = "foot landing"  #: a step ended with its foot unloaded; it reached further

@@ -94,6 +94,7 @@ from execute.motion.events import MotionEvent, MotionEventKind, MotionStop
 from execute.motion.gains import motion_pwm_gains
 from execute.motion.grasp_check import GraspReading, closed_around_rail, read_grasp
 from execute.motion.gravity_compensation import ArmGravityCompensation
+from execute.motion.grip_bending_relief import GripBendingRelief
 from execute.motion.grip_load import GripLoad
 from execute.motion.ladder_estimate import LadderEstimate, RailObservation
 from execute.motion.leg_relief import LegRelief
@@ -253,6 +254,10 @@ class MotionLayer:
         self.wrist_relief = WristRelief(robot)
         self.leg_relief = LegRelief(self.model, robot)
         self.grip_load = GripLoad(self.model, ladder.friction, ladder.rail_radius_m)
+        onset = self.config.grip_bending_onset
+        self.bending_relief = None if onset == 0.0 else GripBendingRelief(
+            self.model, self.grip_load.capacity.bending_nm, onset_share=onset,
+            release_share=onset * 2.0 / 3.0)
         #: The gains the daemon should run the compliant arms with (`execute.motion.gains`).
         self.pwm_gains = motion_pwm_gains()
         self._last_now: float | None = None
@@ -1310,6 +1315,7 @@ class MotionLayer:
         if self.config.gravity_compensation and comply.any():  # else ff goes unused
             ff = self.gravity.feedforward_nm(ff, plan_rad, s.pos_rad, self.estimate.R_tilt)
         ff = self._relieve_legs(seg, lifting, closed, s, ff, dt)
+        ff = self._relieve_bending(lifting, closed, s, ff, dt)
         if ff is not tick.feedforward_nm or comply is not tick.comply:
             ff = np.where(comply, ff, 0.0)  # feed-forward acts only on compliant joints
         return dataclasses.replace(tick, ref_rad=ref, mode=mode, comply=comply,
@@ -1347,6 +1353,30 @@ class MotionLayer:
         return ff + relief.feedforward_nm(lifting, s.pos_rad, self.estimate.R_tilt,
                                           self._sensed_torque_nm)
 
+    def _relieve_bending(self, lifting: list[str], closed: dict[str, str], s: SensedState,
+                         ff: np.ndarray, dt: float) -> np.ndarray:
+        """``ff`` plus each compliant gripping arm's bending relief
+        (`GripBendingRelief`), for the arms ``lifting`` whose fingers are ``closed``
+        (side → rail)."""
+        relief = self.bending_relief
+        if relief is None:
+            return ff
+        for side in SIDES:
+            rail = closed.get(side)
+            holding = side in lifting and rail is not None
+            was_on = side in relief.active
+            relief.update(side, holding, s.pos_rad, self.estimate.R_tilt,
+                          self._sensed_torque_nm,
+                          self._rail_direction(rail) if holding else np.zeros(3), dt)
+            if side in relief.active and not was_on:
+                share = relief.share[side]
+                self._event(MotionEventKind.GRIP_RELIEF, f"{side}_hand", 0.0,
+                            f"bending torque at {share:.0%} of what the {side} grip holds: "
+                            f"its arm takes the excess off by feed-forward")
+            if holding and side in relief.moment_nm:
+                ff = ff + relief.feedforward_nm(side, s.pos_rad, self.estimate.R_tilt)
+        return ff
+
     # ------------------------------------------------------------------ report
     def report(self) -> dict:
         """What the layer did, for the result JSON."""
@@ -1359,13 +1389,16 @@ class MotionLayer:
                        "arm_max_pwm_pct": float(self.pwm_gains.max_pwm_pct.max()),
                        "max_reach_correction_m": self.config.max_reach_correction_m,
                        "max_body_trim_m": self.config.max_body_trim_m,
-                       "grasp_retries": self.config.grasp_retries},
+                       "grasp_retries": self.config.grasp_retries,
+                       "grip_bending_onset": self.config.grip_bending_onset},
             "counts": counts,
             "ladder_shift_m": [round(float(v), 4) for v in self.ladder.shift_m],
             "ladder_yaw_rad": round(self.ladder.yaw_rad, 4),
             "body_trim_m": round(self._body_trim_m, 4),
             "leg_relief_peak_n": round(self.leg_relief.peak_lift_n, 1),
             "leg_relief_joint": self.leg_relief.peak_joint,
+            "grip_bending_relief_peak_nm": (0.0 if self.bending_relief is None else
+                                            round(self.bending_relief.peak_moment_nm, 2)),
             "stop": None if self.stop is None else dataclasses.asdict(self.stop),
             "events": [ev.to_json() for ev in self.events],
         }

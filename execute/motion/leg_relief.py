@@ -187,7 +187,7 @@ class LegRelief:
             direction = self.direction(q_sensed_rad, R_tilt, self.joint_foot, f"{side}_hand",
                                        torque_nm)
             force = direction * (self.lift_n / len(sides))
-            torque = self.model.force_torques(q_sensed_rad, R_tilt, f"{side}_hand", force)
+            torque = self.model.wrench_torques(q_sensed_rad, R_tilt, f"{side}_hand", force)
             cols = list(self.model.chains[f"{side}_hand"].columns)
             out[cols] = -torque[cols]
         return out

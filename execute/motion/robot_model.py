@@ -131,15 +131,18 @@ class MotionRobotModel:
         self._gravity_memo = [(key, out), *self._gravity_memo[:1]]
         return out.copy()
 
-    def force_torques(self, q_cols_rad: np.ndarray, R_world_pelvis: np.ndarray, limb: str,
-                      force_world_n: np.ndarray) -> np.ndarray:
-        """``Jᵀ f`` by column [N·m]: the generalized force of a force ``force_world_n``
-        (world frame) applied at ``limb``'s end frame (its palm or sole), the pelvis
-        tilted by ``R_world_pelvis``."""
+    def wrench_torques(self, q_cols_rad: np.ndarray, R_world_pelvis: np.ndarray, limb: str,
+                       force_world_n: np.ndarray, moment_world_nm: np.ndarray | None = None
+                       ) -> np.ndarray:
+        """``Jᵀ w`` by column [N·m]: the generalized force of a wrench (a force
+        ``force_world_n`` and a moment ``moment_world_nm``, world frame) applied at
+        ``limb``'s end frame (its palm or sole), the pelvis tilted by ``R_world_pelvis``."""
         d = self._kinematics_at(q_cols_rad, R_world_pelvis)
         fid = self._frame_id[self.chains[limb].frame]
         J = pin.getFrameJacobian(self.model, d, fid, pin.LOCAL_WORLD_ALIGNED)
         jt = J[:3].T @ np.asarray(force_world_n, dtype=float)
+        if moment_world_nm is not None:
+            jt = jt + J[3:].T @ np.asarray(moment_world_nm, dtype=float)
         out = np.zeros(len(JOINT_NAMES))
         out[self._have] = jt[self._v_cols]
         return out
