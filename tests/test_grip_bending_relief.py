@@ -77,7 +77,7 @@ def test_below_the_onset_nothing_is_added(model):
 def test_the_term_shrinks_once_the_bending_is_low_and_is_dropped_when_the_hand_lets_go(model):
     q = _gripping_arm()
     relief = GripBendingRelief(model, CAPACITY_NM, onset_share=0.45, release_share=0.3,
-                               decay_nm_per_s=1.0)
+                               decay_nm_per_s=1.0)  # 0.5 N·m in the 0.5 s below
     high = _closed_chain(model, q, np.array([0.0, 0.0, 30.0, 8.0, 0.0, 0.0]))
     for _ in range(200):
         relief.update("left", True, q, np.eye(3), high, RAIL, TICK_S)
@@ -105,3 +105,30 @@ def test_the_term_is_bounded(model):
 def test_an_onset_below_its_release_is_refused(model):
     with pytest.raises(ValueError):
         GripBendingRelief(model, CAPACITY_NM, onset_share=0.3, release_share=0.45)
+    with pytest.raises(ValueError):
+        GripBendingRelief(model, CAPACITY_NM, onset_share=0.35, grip_ceiling_share=0.3)
+
+
+def test_while_a_stance_leg_is_near_its_limit_the_grip_keeps_its_bending(model):
+    """The moment taken off a grip goes to the legs: with a stance leg joint above the
+    guard the term does not grow, and a term already on gives its moment back to a grip
+    below the ceiling."""
+    q = _gripping_arm()
+    relief = GripBendingRelief(model, CAPACITY_NM, onset_share=0.35, release_share=0.23,
+                               decay_nm_per_s=2.0, leg_guard_share=0.85,
+                               grip_ceiling_share=0.8)
+    bent = _closed_chain(model, q, np.array([0.0, 0.0, 30.0, 5.0, 0.0, 0.0]))  # 0.56
+    for _ in range(100):
+        relief.update("left", True, q, np.eye(3), bent, RAIL, TICK_S, leg_share=0.9)
+    assert not relief.moment_nm["left"].any()
+    torque = bent
+    for _ in range(400):  # the legs cool: the term takes the grip back to the onset
+        relief.update("left", True, q, np.eye(3), torque, RAIL, TICK_S, leg_share=0.5)
+        torque = bent + relief.feedforward_nm("left", q, np.eye(3))
+    assert _bending(model, q, torque)[0] == pytest.approx(0.35 * CAPACITY_NM, rel=0.02)
+    grown = float(np.linalg.norm(relief.moment_nm["left"]))
+    for _ in range(100):  # the legs heat again: 0.5 s at 2 N·m/s given back
+        relief.update("left", True, q, np.eye(3), torque, RAIL, TICK_S, leg_share=0.9)
+        torque = bent + relief.feedforward_nm("left", q, np.eye(3))
+    assert float(np.linalg.norm(relief.moment_nm["left"])) == pytest.approx(grown - 1.0,
+                                                                              abs=0.02)

@@ -19,6 +19,14 @@ term settles where the bending is back at the onset. Below ``release_share`` the
 shrinks at ``decay_nm_per_s``; when the hand stops holding it is dropped. The moment
 along the rail is left alone: the grip turns on its rail there, it does not open.
 ``max_moment_share`` bounds the term; each joint's PWM clamp bounds what it can add.
+
+The moment taken off a grip goes to the other holds, the stance legs above all. So the
+term grows only while the stance legs' most loaded joint is below ``leg_guard_share`` of
+its torque limit (the leg relief's onset), and while it is above, the term gives the
+moment back to a grip still below ``grip_ceiling_share``: the load goes to whichever of
+grip and leg has more room. Without that guard, DRC seed 1 under the harder perturbation,
+which climbs without the relief, tripped its stance knee at the mount with 4.7 N·m taken
+off its right grip, the knee going from 0.85 to 1.0 of its limit (S36).
 """
 
 from __future__ import annotations
@@ -44,14 +52,20 @@ class GripBendingRelief:
         gain_per_s: growth of the term per unit of excess bending, per second [1/s].
         decay_nm_per_s: how fast it shrinks below ``release_share`` [N·m/s].
         max_moment_share: bound on the term, as a share of the capacity [-].
+        leg_guard_share: share of a stance leg joint's torque limit above which the term
+            may not grow [-].
+        grip_ceiling_share: while the legs are above their guard, the term shrinks as
+            long as the grip's bending is below this share [-].
     """
 
     def __init__(self, model: MotionRobotModel, bending_capacity_nm: float,
                  onset_share: float = 0.45, release_share: float = 0.3,
-                 gain_per_s: float = 4.0, decay_nm_per_s: float = 1.0,
-                 max_moment_share: float = 1.0):
-        if not 0.0 < release_share < onset_share < 1.0:
-            raise ValueError("need 0 < release_share < onset_share < 1")
+                 gain_per_s: float = 4.0, decay_nm_per_s: float = 2.0,
+                 max_moment_share: float = 1.0, leg_guard_share: float = 0.85,
+                 grip_ceiling_share: float = 0.8):
+        if not 0.0 < release_share < onset_share < grip_ceiling_share < 1.0:
+            raise ValueError("need 0 < release_share < onset_share < grip_ceiling_share < 1")
+        self.leg_guard, self.grip_ceiling = leg_guard_share, grip_ceiling_share
         self.model = model
         self.capacity_nm = bending_capacity_nm
         self.onset, self.release = onset_share, release_share
@@ -68,7 +82,8 @@ class GripBendingRelief:
         self.peak_moment_nm = 0.0
 
     def update(self, side: str, holding: bool, q_rad: np.ndarray, R_tilt: np.ndarray,
-               torque_nm: np.ndarray, rail_axis: np.ndarray, dt_s: float) -> None:
+               torque_nm: np.ndarray, rail_axis: np.ndarray, dt_s: float,
+               leg_share: float = 0.0) -> None:
         """One tick of ``side``'s term.
 
         Args:
@@ -79,6 +94,8 @@ class GripBendingRelief:
             torque_nm: joint torques by column, from the motor currents [N·m].
             rail_axis: the rail's unit direction, world frame.
             dt_s: time since the last tick [s].
+            leg_share: the stance legs' most loaded joint, as a share of its torque
+                limit [-] (`execute.motion.leg_relief.LegRelief.load_share`).
         """
         if not holding:
             self.moment_nm.pop(side, None)
@@ -92,12 +109,15 @@ class GripBendingRelief:
         share = size / self.capacity_nm
         self.share[side] = share
         term = self.moment_nm.get(side, np.zeros(3))
+        legs_hot = leg_share > self.leg_guard
         if share > self.onset:
             self.active.add(side)
-            excess = bending * (1.0 - self.onset / share)
-            term = term - self.gain_per_s * dt_s * excess
         elif share < self.release:
             self.active.discard(side)
+        if share > self.onset and not legs_hot:
+            excess = bending * (1.0 - self.onset / share)
+            term = term - self.gain_per_s * dt_s * excess
+        elif share < self.release or (legs_hot and share < self.grip_ceiling):
             length = math.sqrt(float(term @ term))
             if length > 0.0:
                 term = term * max(0.0, 1.0 - self.decay_nm_per_s * dt_s / length)

@@ -1367,7 +1367,8 @@ class MotionLayer:
             was_on = side in relief.active
             relief.update(side, holding, s.pos_rad, self.estimate.R_tilt,
                           self._sensed_torque_nm,
-                          self._rail_direction(rail) if holding else np.zeros(3), dt)
+                          self._rail_direction(rail) if holding else np.zeros(3), dt,
+                          self.leg_relief.load_share)
             if side in relief.active and not was_on:
                 share = relief.share[side]
                 self._event(MotionEventKind.GRIP_RELIEF, f"{side}_hand", 0.0,
