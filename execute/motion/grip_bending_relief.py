@@ -20,13 +20,17 @@ shrinks at ``decay_nm_per_s``; when the hand stops holding it is dropped. The mo
 along the rail is left alone: the grip turns on its rail there, it does not open.
 ``max_moment_share`` bounds the term; each joint's PWM clamp bounds what it can add.
 
-The moment taken off a grip goes to the other holds, the stance legs above all. So the
-term grows only while the stance legs' most loaded joint is below ``leg_guard_share`` of
-its torque limit (the leg relief's onset), and while it is above, the term gives the
-moment back to a grip still below ``grip_ceiling_share``: the load goes to whichever of
-grip and leg has more room. Without that guard, DRC seed 1 under the harder perturbation,
-which climbs without the relief, tripped its stance knee at the mount with 4.7 N·m taken
-off its right grip, the knee going from 0.85 to 1.0 of its limit (S36).
+The moment taken off a grip goes to the other holds, the stance legs above all: a moment
+``m`` asked of the rail on the palm changes a stance leg joint's torque by ``b·m``, ``b``
+the angular part of that joint's column of the sole's Jacobian (the foot taking the
+whole reaction, as the leg relief assumes). Each step of the term is projected so that it
+raises no stance leg joint already above ``leg_guard_share`` of its torque limit (the
+leg relief's onset), and keeps no part along the rail. Without that guard, DRC seed 1
+under the harder perturbation, which climbs without the relief, tripped its stance knee
+at the mount with 4.7 N·m taken off its right grip, the knee going from 0.85 to 1.0 of
+its limit; a guard that stopped the term, or gave it back, whenever a leg was above 0.85
+tripped seed 4's knee instead, the leg relief's lift then giving way to the bent grip
+(S36).
 """
 
 from __future__ import annotations
@@ -34,8 +38,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from scipy.optimize import nnls
 
 from execute.motion.robot_model import MotionRobotModel
+from robot.joints import LEG_JOINTS, joint_indices
+from robot.limits import joint_limits
 
 __all__ = ["GripBendingRelief"]
 
@@ -53,19 +60,21 @@ class GripBendingRelief:
         decay_nm_per_s: how fast it shrinks below ``release_share`` [N·m/s].
         max_moment_share: bound on the term, as a share of the capacity [-].
         leg_guard_share: share of a stance leg joint's torque limit above which the term
-            may not grow [-].
-        grip_ceiling_share: while the legs are above their guard, the term shrinks as
-            long as the grip's bending is below this share [-].
+            may not load it further [-].
+        robot: robot name (torque limits).
     """
 
     def __init__(self, model: MotionRobotModel, bending_capacity_nm: float,
                  onset_share: float = 0.45, release_share: float = 0.3,
                  gain_per_s: float = 4.0, decay_nm_per_s: float = 2.0,
                  max_moment_share: float = 1.0, leg_guard_share: float = 0.85,
-                 grip_ceiling_share: float = 0.8):
-        if not 0.0 < release_share < onset_share < grip_ceiling_share < 1.0:
-            raise ValueError("need 0 < release_share < onset_share < grip_ceiling_share < 1")
-        self.leg_guard, self.grip_ceiling = leg_guard_share, grip_ceiling_share
+                 robot: str = "drc-hubo"):
+        if not 0.0 < release_share < onset_share < 1.0:
+            raise ValueError("need 0 < release_share < onset_share < 1")
+        self.leg_guard = leg_guard_share
+        self.limit_nm = joint_limits(robot).torque_max_nm
+        self._leg_cols = {side: np.array(joint_indices(LEG_JOINTS[side]))
+                          for side in LEG_JOINTS}
         self.model = model
         self.capacity_nm = bending_capacity_nm
         self.onset, self.release = onset_share, release_share
@@ -83,7 +92,7 @@ class GripBendingRelief:
 
     def update(self, side: str, holding: bool, q_rad: np.ndarray, R_tilt: np.ndarray,
                torque_nm: np.ndarray, rail_axis: np.ndarray, dt_s: float,
-               leg_share: float = 0.0) -> None:
+               stance_sides: tuple[str, ...] = ()) -> None:
         """One tick of ``side``'s term.
 
         Args:
@@ -94,8 +103,7 @@ class GripBendingRelief:
             torque_nm: joint torques by column, from the motor currents [N·m].
             rail_axis: the rail's unit direction, world frame.
             dt_s: time since the last tick [s].
-            leg_share: the stance legs' most loaded joint, as a share of its torque
-                limit [-] (`execute.motion.leg_relief.LegRelief.load_share`).
+            stance_sides: the sides whose feet stand on their holds.
         """
         if not holding:
             self.moment_nm.pop(side, None)
@@ -109,15 +117,14 @@ class GripBendingRelief:
         share = size / self.capacity_nm
         self.share[side] = share
         term = self.moment_nm.get(side, np.zeros(3))
-        legs_hot = leg_share > self.leg_guard
         if share > self.onset:
             self.active.add(side)
+            excess = bending * (1.0 - self.onset / share)
+            step = self._spare_hot_legs(-self.gain_per_s * dt_s * excess, q_rad, R_tilt,
+                                        torque_nm, rail_axis, stance_sides)
+            term = term + step
         elif share < self.release:
             self.active.discard(side)
-        if share > self.onset and not legs_hot:
-            excess = bending * (1.0 - self.onset / share)
-            term = term - self.gain_per_s * dt_s * excess
-        elif share < self.release or (legs_hot and share < self.grip_ceiling):
             length = math.sqrt(float(term @ term))
             if length > 0.0:
                 term = term * max(0.0, 1.0 - self.decay_nm_per_s * dt_s / length)
@@ -126,6 +133,25 @@ class GripBendingRelief:
             term = term * (self.max_moment_nm / length)
         self.moment_nm[side] = term
         self.peak_moment_nm = max(self.peak_moment_nm, min(length, self.max_moment_nm))
+
+    def _spare_hot_legs(self, step: np.ndarray, q_rad: np.ndarray, R_tilt: np.ndarray,
+                        torque_nm: np.ndarray, rail_axis: np.ndarray,
+                        stance_sides: tuple[str, ...]) -> np.ndarray:
+        """``step`` (a change of the term [N·m], world) projected onto the moments that
+        raise no stance leg joint above the guard and have no part along the rail
+        (module docstring)."""
+        rows = [rail_axis[None, :], -rail_axis[None, :]]
+        for leg in stance_sides:
+            cols = self._leg_cols[leg]
+            hot = cols[np.abs(torque_nm[cols]) > self.leg_guard * self.limit_nm[cols]]
+            if len(hot):
+                b = self.model.stance_moment_gradient(q_rad, R_tilt, hot, f"{leg}_foot")
+                rows.append(np.sign(torque_nm[hot])[:, None] * b)
+        loading = np.vstack(rows)
+        if len(loading) == 2 or not (loading @ step > 1e-12).any():
+            return step
+        polar = loading.T  # (3, k): the step must have no positive part along any column
+        return step - polar @ nnls(polar, step)[0]
 
     def feedforward_nm(self, side: str, q_rad: np.ndarray, R_tilt: np.ndarray) -> np.ndarray:
         """Feed-forward torques by column [N·m] that make the rail's moment on ``side``'s

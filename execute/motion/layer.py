@@ -1315,18 +1315,22 @@ class MotionLayer:
         if self.config.gravity_compensation and comply.any():  # else ff goes unused
             ff = self.gravity.feedforward_nm(ff, plan_rad, s.pos_rad, self.estimate.R_tilt)
         ff = self._relieve_legs(seg, lifting, closed, s, ff, dt)
-        ff = self._relieve_bending(lifting, closed, s, ff, dt)
+        ff = self._relieve_bending(seg, lifting, closed, s, ff, dt)
         if ff is not tick.feedforward_nm or comply is not tick.comply:
             ff = np.where(comply, ff, 0.0)  # feed-forward acts only on compliant joints
         return dataclasses.replace(tick, ref_rad=ref, mode=mode, comply=comply,
                                    feedforward_nm=ff)
 
+    def _stance_sides(self, seg: Segment) -> tuple[str, ...]:
+        """The sides whose feet hold in ``seg`` and stand, as their F/T sensors show."""
+        return tuple(side for side in SIDES if f"{side}_foot" in seg.holds
+                     and self.estimate.standing.get(side, False))
+
     def _relieve_legs(self, seg: Segment, lifting: list[str], closed: dict[str, str],
                       s: SensedState, ff: np.ndarray, dt: float) -> np.ndarray:
         """``ff`` plus the leg relief's lift on the ``lifting`` arms (`LegRelief`), bounded
         by the loads of the grips ``closed`` (side → rail)."""
-        stance = [side for side in SIDES if f"{side}_foot" in seg.holds
-                  and self.estimate.standing.get(side, False)]
+        stance = list(self._stance_sides(seg))
         relief = self.leg_relief
         before, was_bound = relief.lift_n, relief.grip_bound
         # side → (share, load) of each closed grip; only a lift on or due needs them
@@ -1353,14 +1357,15 @@ class MotionLayer:
         return ff + relief.feedforward_nm(lifting, s.pos_rad, self.estimate.R_tilt,
                                           self._sensed_torque_nm)
 
-    def _relieve_bending(self, lifting: list[str], closed: dict[str, str], s: SensedState,
-                         ff: np.ndarray, dt: float) -> np.ndarray:
+    def _relieve_bending(self, seg: Segment, lifting: list[str], closed: dict[str, str],
+                         s: SensedState, ff: np.ndarray, dt: float) -> np.ndarray:
         """``ff`` plus each compliant gripping arm's bending relief
         (`GripBendingRelief`), for the arms ``lifting`` whose fingers are ``closed``
         (side → rail)."""
         relief = self.bending_relief
         if relief is None:
             return ff
+        stance = self._stance_sides(seg)
         for side in SIDES:
             rail = closed.get(side)
             holding = side in lifting and rail is not None
@@ -1368,7 +1373,7 @@ class MotionLayer:
             relief.update(side, holding, s.pos_rad, self.estimate.R_tilt,
                           self._sensed_torque_nm,
                           self._rail_direction(rail) if holding else np.zeros(3), dt,
-                          self.leg_relief.load_share)
+                          stance)
             if side in relief.active and not was_on:
                 share = relief.share[side]
                 self._event(MotionEventKind.GRIP_RELIEF, f"{side}_hand", 0.0,

@@ -166,6 +166,21 @@ class MotionRobotModel:
         held = self.gravity_torques(q_cols_rad, R_world_pelvis)[cols] - torque_nm[cols]
         return np.linalg.lstsq(J.T, held, rcond=None)[0]
 
+    def stance_moment_gradient(self, q_cols_rad: np.ndarray, R_world_pelvis: np.ndarray,
+                               joint_cols: np.ndarray, foot: str) -> np.ndarray:
+        """∂τ/∂m [N·m/N·m]: how the torques of leg joints ``joint_cols`` change with a
+        moment m (world frame) of the environment on a hand, when the stance foot
+        ``foot`` (a limb name) takes its reaction; (k, 3).
+
+        The foot's wrench changes by ``−(0, m)``, and a leg joint's torque is
+        ``g − Jᵀw`` over its foot's wrench: ∂τ/∂m = b, the angular part of the joint's
+        column of the sole's Jacobian (a pure moment has no lever arm).
+        """
+        d = self._kinematics_at(q_cols_rad, R_world_pelvis)
+        sole = self._frame_id[self.chains[foot].frame]
+        jacobian = pin.getFrameJacobian(self.model, d, sole, pin.LOCAL_WORLD_ALIGNED)
+        return jacobian[3:, self._v_of_col[np.asarray(joint_cols)]].T
+
     def stance_torque_gradient(self, q_cols_rad: np.ndarray, R_world_pelvis: np.ndarray,
                                joint_cols: int | np.ndarray, foot: str, hand: str
                                ) -> np.ndarray:
