@@ -145,10 +145,13 @@ class MotionConfig:
         grip_bending_onset: share of a closed grip's bending capacity above which its
             compliant arm's feed-forward asks the rail for the opposite moment, until the
             bending estimated from the arm's currents is back at this share
-            (`execute.motion.grip_bending_relief`); 0: never [-]. It stays below the
-            leg relief's 0.4, under which a lift that gave way to a bent grip may grow
-            again: at 0.45 a grip held at 0.45 kept the lift off and a knee tripped (DRC
-            seeds 1 and 4 under the harder perturbation, S36).
+            (`execute.motion.grip_bending_relief`); 0: never (the default; tried at
+            0.35, docs/decisions/grip-bending-relief.md: it did not hold the grip
+            through a held wrist's zero-pitch crossing, and lost a nominal DRC climb
+            there) [-]. It stays below the leg relief's 0.4, under which a lift that
+            gave way to a bent grip may grow again: at 0.45 a grip held at 0.45 kept the
+            lift off and a knee tripped (DRC seeds 1 and 4 under the harder
+            perturbation, S36).
         estimator: the state estimator's thresholds.
     """
 
@@ -179,7 +182,7 @@ class MotionConfig:
     replan_beyond_m: float = 0.0
     max_body_trim_m: float = 0.0
     max_foot_aim_m: float = 0.0
-    grip_bending_onset: float = 0.35
+    grip_bending_onset: float = 0.0
     estimator: EstimatorConfig = field(default_factory=EstimatorConfig)
 
     def __post_init__(self) -> None:
@@ -239,7 +242,8 @@ def add_motion_arguments(parser: argparse.ArgumentParser) -> None:
                         metavar="SHARE",
                         help="closed loop: share of a grip's bending capacity above which "
                              "the compliant arm holding it takes the excess off by "
-                             "feed-forward, " + within("grip_bending_onset") + ", 0 never")
+                             "feed-forward, " + within("grip_bending_onset") + ", 0 never "
+                             "(experimental: docs/decisions/grip-bending-relief.md)")
 
 
 def motion_config_from_args(args: argparse.Namespace) -> MotionConfig:

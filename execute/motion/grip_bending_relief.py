@@ -13,12 +13,23 @@ nominal seed 2 crossed the same zero at 0.88 of the capacity; docs/results.md, S
 The bending is estimated from the arm's motor currents (`MotionRobotModel.hand_wrench`,
 the same estimate as `execute.motion.grip_load`). While it is above ``onset_share`` of
 the capacity, an integral term asks the rail for the opposite moment: a feed-forward
-``−Jᵀ(0, Δm)`` on the arm's joints, ``Δm`` growing at ``gain_per_s`` times the excess.
+``−Jᵀ(0, Δm)`` on the arm's shoulder and elbow, ``Δm`` growing at ``gain_per_s`` times the excess.
 The currents carry the feed-forward, so the next estimate includes its effect and the
-term settles where the bending is back at the onset. Below ``release_share`` the term
-shrinks at ``decay_nm_per_s``; when the hand stops holding it is dropped. The moment
-along the rail is left alone: the grip turns on its rail there, it does not open.
-``max_moment_share`` bounds the term; each joint's PWM clamp bounds what it can add.
+term settles where the bending is back at the onset.
+
+The feed-forward acts on the shoulder and elbow only. The compliant wrist is what lets
+the hand give way to the rail; a feed-forward on its joints (1.4–1.7 N·m at their PWM
+clamp) holds them instead. With the wrist left to its PWM law, the proximal joints'
+moment reaches the palm about the directions the wrist cannot turn, which is where the
+bending comes from. On the nominal DRC seed 2's zero-pitch crossing the grip's bending
+peaked at 0.91 of its capacity without the relief, let go at 1.01 with the feed-forward
+on all seven joints (the wrist pitch held back: 0.063 rad at 79.4 s against 0.089 rad
+without), and peaked at 0.62 with it on the shoulder and elbow (S36).
+
+Below ``release_share`` the term shrinks at ``decay_nm_per_s``; when the hand stops
+holding it is dropped. The moment along the rail is left alone: the grip turns on its
+rail there, it does not open. ``max_moment_share`` bounds the term; each joint's PWM
+clamp bounds what it can add.
 
 The moment taken off a grip goes to the other holds, the stance legs above all: a moment
 ``m`` asked of the rail on the palm changes a stance leg joint's torque by ``b·m``, ``b``
@@ -41,10 +52,13 @@ import numpy as np
 from scipy.optimize import nnls
 
 from execute.motion.robot_model import MotionRobotModel
-from robot.joints import LEG_JOINTS, joint_indices
+from robot.joints import JOINT_INDEX, LEG_JOINTS
 from robot.limits import joint_limits
 
 __all__ = ["GripBendingRelief"]
+
+#: the arm joints the term's feed-forward acts on (module docstring)
+_SHOULDER_AND_ELBOW = ("SP", "SR", "SY", "EB")
 
 
 class GripBendingRelief:
@@ -73,8 +87,13 @@ class GripBendingRelief:
             raise ValueError("need 0 < release_share < onset_share < 1")
         self.leg_guard = leg_guard_share
         self.limit_nm = joint_limits(robot).torque_max_nm
-        self._leg_cols = {side: np.array(joint_indices(LEG_JOINTS[side]))
+        self._leg_cols = {side: np.array([JOINT_INDEX[n] for n in LEG_JOINTS[side]])
                           for side in LEG_JOINTS}
+        #: the shoulder and elbow joints of each arm: the term's feed-forward acts on
+        #: them alone (module docstring)
+        self._proximal_cols = {side: [JOINT_INDEX[side[0].upper() + j]
+                                      for j in _SHOULDER_AND_ELBOW]
+                               for side in ("left", "right")}
         self.model = model
         self.capacity_nm = bending_capacity_nm
         self.onset, self.release = onset_share, release_share
@@ -161,6 +180,6 @@ class GripBendingRelief:
         if term is None or not term.any():
             return out
         torque = self.model.wrench_torques(q_rad, R_tilt, f"{side}_hand", np.zeros(3), term)
-        cols = list(self.model.chains[f"{side}_hand"].columns)
+        cols = self._proximal_cols[side]
         out[cols] = -torque[cols]
         return out
