@@ -145,13 +145,10 @@ class MotionConfig:
         grip_bending_onset: share of a closed grip's bending capacity above which its
             compliant arm's feed-forward asks the rail for the opposite moment, until the
             bending estimated from the arm's currents is back at this share
-            (`execute.motion.grip_bending_relief`); 0: never (the default; tried at
-            0.35, docs/decisions/grip-bending-relief.md: it climbed nominal DRC seeds
-            1–4, one more than without it, and fewer mounts under the harder
-            perturbation, its moment going to stance legs at their limits) [-]. It
-            stays below the leg relief's 0.4, under which a lift that gave way to a bent
-            grip may grow again: at 0.45 a grip held at 0.45 kept the lift off and a
-            knee tripped (DRC seeds 1 and 4 under the harder perturbation, S36).
+            (`execute.motion.grip_bending_relief`); 0: never (the default;
+            experimental, docs/decisions/grip-bending-relief.md) [-]. It stays below
+            the leg relief's 0.4, under which a lift that gave way to a bent grip may
+            grow again: a grip held between the two keeps the lift off.
         estimator: the state estimator's thresholds.
     """
 

@@ -4,44 +4,36 @@ The planner holds a hand as a point: it plans forces on the rail and no moment
 (docs/decisions/contact-model.md). A compliant arm's joints still push the hand with
 whatever their PWM law gives at the sensed configuration, and what the wrist cannot give
 way to reaches the grip as a moment. Across the rail that moment pries the fingers open
-(`ladders.contact_model.GripCapacity.bending_nm`, 9 N·m on the Hubo hand). It peaks where
-the plan turns a held wrist through zero pitch: there the wrist's yaw and roll axes line
-up and the wrist cannot give way about the third direction (DRC seeds 2 and 4 under the
-harder perturbation lost their right grips to bending at 9.2–9.4 N·m that way, and the
-nominal seed 2 crossed the same zero at 0.88 of the capacity; docs/results.md, S35).
+(`ladders.contact_model.GripCapacity.bending_nm`). It peaks where the plan turns a held
+wrist through zero pitch: there the wrist's yaw and roll axes line up and the wrist
+cannot give way about the third direction.
 
 The bending is estimated from the arm's motor currents (`MotionRobotModel.hand_wrench`,
-the same estimate as `execute.motion.grip_load`). While it is above ``onset_share`` of
-the capacity, an integral term asks the rail for the opposite moment: a feed-forward
-``−Jᵀ(0, Δm)`` on the arm's shoulder and elbow, ``Δm`` growing at ``gain_per_s`` times the excess.
-The currents carry the feed-forward, so the next estimate includes its effect and the
-term settles where the bending is back at the onset.
+the estimate `execute.motion.grip_load` reads). While it is above ``onset_share`` of the
+capacity, an integral term asks the rail for the opposite moment: a feed-forward
+``−Jᵀ(0, Δm)``, ``Δm`` growing at ``gain_per_s`` times the excess. The currents carry
+the feed-forward, so the next estimate includes its effect and the term settles where
+the bending is back at the onset. Below ``release_share`` the term shrinks at
+``decay_nm_per_s``; when the hand stops holding it is dropped. The moment along the rail
+is left alone: the grip turns on its rail there, it does not open. ``max_moment_share``
+bounds the term; each joint's PWM clamp bounds what it can add.
 
 The feed-forward acts on the shoulder and elbow only. The compliant wrist is what lets
-the hand give way to the rail; a feed-forward on its joints (1.4–1.7 N·m at their PWM
-clamp) holds them instead. With the wrist left to its PWM law, the proximal joints'
-moment reaches the palm about the directions the wrist cannot turn, which is where the
-bending comes from. On the nominal DRC seed 2's zero-pitch crossing the grip's bending
-peaked at 0.91 of its capacity without the relief, let go at 1.01 with the feed-forward
-on all seven joints (the wrist pitch held back: 0.063 rad at 79.4 s against 0.089 rad
-without), and peaked at 0.62 with it on the shoulder and elbow (S36).
-
-Below ``release_share`` the term shrinks at ``decay_nm_per_s``; when the hand stops
-holding it is dropped. The moment along the rail is left alone: the grip turns on its
-rail there, it does not open. ``max_moment_share`` bounds the term; each joint's PWM
-clamp bounds what it can add.
+the hand give way to the rail; a feed-forward on its joints holds them instead (on a
+zero-pitch crossing it held the wrist pitch back, near the alignment, and the grip let
+go). At the alignment the wrist's joints carry no torque for a moment about the
+direction they cannot turn about, so the shoulder and elbow alone hold exactly that
+moment.
 
 The moment taken off a grip goes to the other holds, the stance legs above all: a moment
 ``m`` asked of the rail on the palm changes a stance leg joint's torque by ``b·m``, ``b``
 the angular part of that joint's column of the sole's Jacobian (the foot taking the
 whole reaction, as the leg relief assumes). Each step of the term is projected so that it
 raises no stance leg joint already above ``leg_guard_share`` of its torque limit (the
-leg relief's onset), and keeps no part along the rail. Without that guard, DRC seed 1
-under the harder perturbation, which climbs without the relief, tripped its stance knee
-at the mount with 4.7 N·m taken off its right grip, the knee going from 0.85 to 1.0 of
-its limit; a guard that stopped the term, or gave it back, whenever a leg was above 0.85
-tripped seed 4's knee instead, the leg relief's lift then giving way to the bent grip
-(S36).
+leg relief's onset), and keeps no part along the rail.
+
+What was measured with it, and why it is off by default:
+docs/decisions/grip-bending-relief.md.
 """
 
 from __future__ import annotations
@@ -49,8 +41,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.optimize import nnls
 
+from execute.motion.leg_relief import project_off_cone
 from execute.motion.robot_model import MotionRobotModel
 from robot.joints import JOINT_INDEX, LEG_JOINTS
 from robot.limits import joint_limits
@@ -69,7 +61,8 @@ class GripBendingRelief:
         model: the motion layer's robot model.
         bending_capacity_nm: the bending torque the grip holds [N·m].
         onset_share: share of the capacity above which the term grows [-].
-        release_share: share below which it shrinks [-].
+        release_share: share below which it shrinks [-]; two thirds of the onset when
+            None.
         gain_per_s: growth of the term per unit of excess bending, per second [1/s].
         decay_nm_per_s: how fast it shrinks below ``release_share`` [N·m/s].
         max_moment_share: bound on the term, as a share of the capacity [-].
@@ -79,10 +72,12 @@ class GripBendingRelief:
     """
 
     def __init__(self, model: MotionRobotModel, bending_capacity_nm: float,
-                 onset_share: float = 0.45, release_share: float = 0.3,
+                 onset_share: float = 0.35, release_share: float | None = None,
                  gain_per_s: float = 4.0, decay_nm_per_s: float = 2.0,
                  max_moment_share: float = 1.0, leg_guard_share: float = 0.85,
                  robot: str = "drc-hubo"):
+        if release_share is None:
+            release_share = onset_share * 2.0 / 3.0
         if not 0.0 < release_share < onset_share < 1.0:
             raise ValueError("need 0 < release_share < onset_share < 1")
         self.leg_guard = leg_guard_share
@@ -142,16 +137,16 @@ class GripBendingRelief:
             step = self._spare_hot_legs(-self.gain_per_s * dt_s * excess, q_rad, R_tilt,
                                         torque_nm, rail_axis, stance_sides)
             term = term + step
-        elif share < self.release:
-            self.active.discard(side)
-            length = math.sqrt(float(term @ term))
-            if length > 0.0:
-                term = term * max(0.0, 1.0 - self.decay_nm_per_s * dt_s / length)
         length = math.sqrt(float(term @ term))
+        if share < self.release:
+            self.active.discard(side)
+            if length > 0.0:
+                shrunk = max(0.0, length - self.decay_nm_per_s * dt_s)
+                term, length = term * (shrunk / length), shrunk
         if length > self.max_moment_nm:
-            term = term * (self.max_moment_nm / length)
+            term, length = term * (self.max_moment_nm / length), self.max_moment_nm
         self.moment_nm[side] = term
-        self.peak_moment_nm = max(self.peak_moment_nm, min(length, self.max_moment_nm))
+        self.peak_moment_nm = max(self.peak_moment_nm, length)
 
     def _spare_hot_legs(self, step: np.ndarray, q_rad: np.ndarray, R_tilt: np.ndarray,
                         torque_nm: np.ndarray, rail_axis: np.ndarray,
@@ -169,17 +164,13 @@ class GripBendingRelief:
         loading = np.vstack(rows)
         if len(loading) == 2 or not (loading @ step > 1e-12).any():
             return step
-        polar = loading.T  # (3, k): the step must have no positive part along any column
-        return step - polar @ nnls(polar, step)[0]
+        return project_off_cone(step, loading)
 
     def feedforward_nm(self, side: str, q_rad: np.ndarray, R_tilt: np.ndarray) -> np.ndarray:
         """Feed-forward torques by column [N·m] that make the rail's moment on ``side``'s
         palm change by its term (zero off that arm, and when no term is on)."""
-        out = np.zeros(len(q_rad))
         term = self.moment_nm.get(side)
         if term is None or not term.any():
-            return out
-        torque = self.model.wrench_torques(q_rad, R_tilt, f"{side}_hand", np.zeros(3), term)
-        cols = self._proximal_cols[side]
-        out[cols] = -torque[cols]
-        return out
+            return np.zeros(len(q_rad))
+        return self.model.wrench_feedforward_nm(q_rad, R_tilt, f"{side}_hand", np.zeros(3),
+                                                term, self._proximal_cols[side])

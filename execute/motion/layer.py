@@ -245,6 +245,7 @@ class MotionLayer:
         self.sidecar = sidecar
         self.config = config or MotionConfig()
         self.geometry = LadderGeometry(ladder)
+        self._rail_axes: dict[str, np.ndarray] = {}  # rail → unit direction (`_rail_direction`)
         self.model = MotionRobotModel(robot)
         first = sidecar.segments[0]
         soles = {_side(limb): np.asarray(h.position_m) for limb, h in first.holds.items()
@@ -256,8 +257,7 @@ class MotionLayer:
         self.grip_load = GripLoad(self.model, ladder.friction, ladder.rail_radius_m)
         onset = self.config.grip_bending_onset
         self.bending_relief = None if onset == 0.0 else GripBendingRelief(
-            self.model, self.grip_load.capacity.bending_nm, onset_share=onset,
-            release_share=onset * 2.0 / 3.0)
+            self.model, self.grip_load.capacity.bending_nm, onset_share=onset)
         #: The gains the daemon should run the compliant arms with (`execute.motion.gains`).
         self.pwm_gains = motion_pwm_gains()
         self._last_now: float | None = None
@@ -404,8 +404,13 @@ class MotionLayer:
         return all(h.target == "floor" for limb, h in seg.holds.items() if limb.endswith("_foot"))
 
     def _rail_direction(self, rail: str) -> np.ndarray:
-        p0, p1 = self.geometry.rail_axis(rail.removeprefix("rail_"))
-        return (p1 - p0) / np.linalg.norm(p1 - p0)
+        """The plan's ladder's ``rail`` as a unit direction, world (asked every tick for
+        each closed grip: computed once per rail)."""
+        axis = self._rail_axes.get(rail)
+        if axis is None:
+            p0, p1 = self.geometry.rail_axis(rail.removeprefix("rail_"))
+            axis = self._rail_axes[rail] = (p1 - p0) / np.linalg.norm(p1 - p0)
+        return axis
 
     # ------------------------------------------------------------------ events
     def _event(self, kind: MotionEventKind, limb: str, size_m: float, cause: str) -> None:
@@ -1314,8 +1319,9 @@ class MotionLayer:
         ff = tick.feedforward_nm
         if self.config.gravity_compensation and comply.any():  # else ff goes unused
             ff = self.gravity.feedforward_nm(ff, plan_rad, s.pos_rad, self.estimate.R_tilt)
-        ff = self._relieve_legs(seg, lifting, closed, s, ff, dt)
-        ff = self._relieve_bending(seg, lifting, closed, s, ff, dt)
+        stance = self._stance_sides(seg)
+        ff = self._relieve_legs(stance, lifting, closed, s, ff, dt)
+        ff = self._relieve_bending(stance, lifting, closed, s, ff, dt)
         if ff is not tick.feedforward_nm or comply is not tick.comply:
             ff = np.where(comply, ff, 0.0)  # feed-forward acts only on compliant joints
         return dataclasses.replace(tick, ref_rad=ref, mode=mode, comply=comply,
@@ -1326,11 +1332,11 @@ class MotionLayer:
         return tuple(side for side in SIDES if f"{side}_foot" in seg.holds
                      and self.estimate.standing.get(side, False))
 
-    def _relieve_legs(self, seg: Segment, lifting: list[str], closed: dict[str, str],
-                      s: SensedState, ff: np.ndarray, dt: float) -> np.ndarray:
-        """``ff`` plus the leg relief's lift on the ``lifting`` arms (`LegRelief`), bounded
-        by the loads of the grips ``closed`` (side → rail)."""
-        stance = list(self._stance_sides(seg))
+    def _relieve_legs(self, stance: tuple[str, ...], lifting: list[str],
+                      closed: dict[str, str], s: SensedState, ff: np.ndarray,
+                      dt: float) -> np.ndarray:
+        """``ff`` plus the leg relief's lift on the ``lifting`` arms (`LegRelief`) for the
+        ``stance`` legs, bounded by the loads of the grips ``closed`` (side → rail)."""
         relief = self.leg_relief
         before, was_bound = relief.lift_n, relief.grip_bound
         # side → (share, load) of each closed grip; only a lift on or due needs them
@@ -1357,15 +1363,15 @@ class MotionLayer:
         return ff + relief.feedforward_nm(lifting, s.pos_rad, self.estimate.R_tilt,
                                           self._sensed_torque_nm)
 
-    def _relieve_bending(self, seg: Segment, lifting: list[str], closed: dict[str, str],
-                         s: SensedState, ff: np.ndarray, dt: float) -> np.ndarray:
+    def _relieve_bending(self, stance: tuple[str, ...], lifting: list[str],
+                         closed: dict[str, str], s: SensedState, ff: np.ndarray,
+                         dt: float) -> np.ndarray:
         """``ff`` plus each compliant gripping arm's bending relief
         (`GripBendingRelief`), for the arms ``lifting`` whose fingers are ``closed``
-        (side → rail)."""
+        (side → rail), sparing the ``stance`` legs."""
         relief = self.bending_relief
         if relief is None:
             return ff
-        stance = self._stance_sides(seg)
         for side in SIDES:
             rail = closed.get(side)
             holding = side in lifting and rail is not None

@@ -50,6 +50,8 @@ switch it every few ticks).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 from scipy.optimize import nnls
 
@@ -57,12 +59,20 @@ from execute.motion.robot_model import MotionRobotModel
 from robot.joints import JOINT_NAMES, LEG_JOINTS, joint_indices
 from robot.limits import joint_limits
 
-__all__ = ["WEIGHT_JOINTS", "LegRelief"]
+__all__ = ["WEIGHT_JOINTS", "LegRelief", "project_off_cone"]
 
 #: Per leg, the joints whose load is the body's weight on it (module docstring).
 WEIGHT_JOINTS = {"left": ("LHP", "LKN"), "right": ("RHP", "RKN")}
 #: Downward: the push's direction never has a part along it (module docstring).
 _DOWN = np.array([[0.0, 0.0, -1.0]])
+
+
+def project_off_cone(vector: np.ndarray, rows: np.ndarray) -> np.ndarray:
+    """The nearest vector to ``vector`` (3,) with no positive part along any of ``rows``
+    (k, 3): its projection onto the cone's polar, ``vector`` less its projection onto the
+    cone the rows span (non-negative least squares)."""
+    cone = rows.T
+    return vector - cone @ nnls(cone, vector)[0]
 
 
 class LegRelief:
@@ -108,7 +118,7 @@ class LegRelief:
         #: Whether the last tick's grips were too loaded for the lift to grow.
         self.grip_bound = False
 
-    def _leg_load(self, stance_sides: list[str], torque_nm: np.ndarray
+    def _leg_load(self, stance_sides: Sequence[str], torque_nm: np.ndarray
                   ) -> tuple[float, int, str]:
         """The largest |τ|/limit over the stance legs' watched joints, its column and its
         leg."""
@@ -121,13 +131,13 @@ class LegRelief:
                 share, col, side = float(shares[k]), int(cols[k]), leg
         return share, col, side
 
-    def needs_grip_share(self, stance_sides: list[str], torque_nm: np.ndarray) -> bool:
+    def needs_grip_share(self, stance_sides: Sequence[str], torque_nm: np.ndarray) -> bool:
         """Whether the next `update` may lift: a lift is on, or a stance leg's watched
         joint is past the onset. Only then does the grips' load matter (estimating it
         costs an arm Jacobian and a least-squares solve per grip, each tick)."""
         return self.lift_n > 0.0 or self._leg_load(stance_sides, torque_nm)[0] > self.onset
 
-    def update(self, stance_sides: list[str], can_lift: bool, torque_nm: np.ndarray,
+    def update(self, stance_sides: Sequence[str], can_lift: bool, torque_nm: np.ndarray,
                dt_s: float, grip_share: float = 0.0) -> float:
         """The lift after one tick [N]. ``can_lift``: a compliant hand grips a rail;
         ``torque_nm``: the sensed joint torques by column [N·m]; ``grip_share``: the
@@ -168,8 +178,7 @@ class LegRelief:
             # each row: the growth of one guarded joint's |τ| per unit push
             loading = np.sign(torque_nm[guarded])[:, None] * gradients[1:]
             if (loading @ d > 0.0).any():
-                polar = np.vstack([loading, _DOWN]).T  # (3, k + 1): the cone's polar
-                d = fastest - polar @ nnls(polar, fastest)[0]
+                d = project_off_cone(fastest, np.vstack([loading, _DOWN]))
                 if float(np.linalg.norm(d)) <= 1e-6 * float(np.linalg.norm(fastest)):
                     return np.zeros(3)
         length = float(np.linalg.norm(d))
@@ -186,8 +195,6 @@ class LegRelief:
         for side in sides:
             direction = self.direction(q_sensed_rad, R_tilt, self.joint_foot, f"{side}_hand",
                                        torque_nm)
-            force = direction * (self.lift_n / len(sides))
-            torque = self.model.wrench_torques(q_sensed_rad, R_tilt, f"{side}_hand", force)
-            cols = list(self.model.chains[f"{side}_hand"].columns)
-            out[cols] = -torque[cols]
+            out += self.model.wrench_feedforward_nm(q_sensed_rad, R_tilt, f"{side}_hand",
+                                                    direction * (self.lift_n / len(sides)))
         return out

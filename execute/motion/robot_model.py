@@ -147,6 +147,20 @@ class MotionRobotModel:
         out[self._have] = jt[self._v_cols]
         return out
 
+    def wrench_feedforward_nm(self, q_cols_rad: np.ndarray, R_world_pelvis: np.ndarray,
+                              limb: str, force_world_n: np.ndarray,
+                              moment_world_nm: np.ndarray | None = None,
+                              columns: list[int] | None = None) -> np.ndarray:
+        """Feed-forward torques by column [N·m] that make the environment push ``limb``'s
+        end frame with the wrench (force, moment; world frame) when the limb is held:
+        ``−Jᵀw`` on ``columns`` (the limb's joints when None), zero elsewhere."""
+        torque = self.wrench_torques(q_cols_rad, R_world_pelvis, limb, force_world_n,
+                                     moment_world_nm)
+        cols = list(self.chains[limb].columns) if columns is None else columns
+        out = np.zeros(len(JOINT_NAMES))
+        out[cols] = -torque[cols]
+        return out
+
     def hand_wrench(self, q_cols_rad: np.ndarray, R_world_pelvis: np.ndarray, hand: str,
                     torque_nm: np.ndarray) -> np.ndarray:
         """The environment's wrench on ``hand``'s palm, ``(f [N], m [N·m])`` about the
@@ -166,6 +180,15 @@ class MotionRobotModel:
         held = self.gravity_torques(q_cols_rad, R_world_pelvis)[cols] - torque_nm[cols]
         return np.linalg.lstsq(J.T, held, rcond=None)[0]
 
+    def _sole_columns(self, q_cols_rad: np.ndarray, R_world_pelvis: np.ndarray,
+                      joint_cols: int | np.ndarray, foot: str):
+        """(kinematics, the columns ``joint_cols`` of ``foot``'s sole Jacobian (6, k),
+        world-aligned), the pelvis tilted by ``R_world_pelvis``."""
+        d = self._kinematics_at(q_cols_rad, R_world_pelvis)
+        sole = self._frame_id[self.chains[foot].frame]
+        jacobian = pin.getFrameJacobian(self.model, d, sole, pin.LOCAL_WORLD_ALIGNED)
+        return d, jacobian[:, self._v_of_col[joint_cols]]
+
     def stance_moment_gradient(self, q_cols_rad: np.ndarray, R_world_pelvis: np.ndarray,
                                joint_cols: np.ndarray, foot: str) -> np.ndarray:
         """∂τ/∂m [N·m/N·m]: how the torques of leg joints ``joint_cols`` change with a
@@ -176,10 +199,8 @@ class MotionRobotModel:
         ``g − Jᵀw`` over its foot's wrench: ∂τ/∂m = b, the angular part of the joint's
         column of the sole's Jacobian (a pure moment has no lever arm).
         """
-        d = self._kinematics_at(q_cols_rad, R_world_pelvis)
-        sole = self._frame_id[self.chains[foot].frame]
-        jacobian = pin.getFrameJacobian(self.model, d, sole, pin.LOCAL_WORLD_ALIGNED)
-        return jacobian[3:, self._v_of_col[np.asarray(joint_cols)]].T
+        return self._sole_columns(q_cols_rad, R_world_pelvis, np.asarray(joint_cols),
+                                  foot)[1][3:].T
 
     def stance_torque_gradient(self, q_cols_rad: np.ndarray, R_world_pelvis: np.ndarray,
                                joint_cols: int | np.ndarray, foot: str, hand: str
@@ -193,11 +214,9 @@ class MotionRobotModel:
         and a leg joint's torque is ``g − Jᵀw`` over its foot's wrench: ∂τ/∂f = a + b × r,
         with (a, b) the joint's column of the sole's Jacobian.
         """
-        d = self._kinematics_at(q_cols_rad, R_world_pelvis)
+        d, column = self._sole_columns(q_cols_rad, R_world_pelvis, joint_cols, foot)
         sole = self._frame_id[self.chains[foot].frame]
         palm = self._frame_id[self.chains[hand].frame]
-        jacobian = pin.getFrameJacobian(self.model, d, sole, pin.LOCAL_WORLD_ALIGNED)
-        column = jacobian[:, self._v_of_col[joint_cols]]
         r = d.oMf[palm].translation - d.oMf[sole].translation
         a, b = column[:3], column[3:]
         b_cross_r = np.array([b[1] * r[2] - b[2] * r[1], b[2] * r[0] - b[0] * r[2],
