@@ -52,6 +52,17 @@ SMALL = JobFunctions(plan=small.small_plan, validate=small.small_validate)
     (["--replan-beyond", "0.5"], ["--replan-beyond", "replan_beyond_m = 0.5", "[0, 0.2]"]),
     (["--replan-beyond", "0.02", "--loop", "open"], ["--replan-beyond is 0.02",
                                                      "only closed-loop runs plan again"]),
+    (["--motion", "grip_bending_onset=0,0.5"], ["--motion", "grip_bending_onset = 0.5",
+                                                "[0, 0.39]"]),
+    (["--motion", "grasp_retries=2.5"], ["--motion", "grasp_retries", "an integer"]),
+    (["--motion", "gravity_compensation=maybe"], ["--motion", "on or off"]),
+    (["--motion", "wobble=1"], ["--motion", "'wobble' is unknown", "grip_bending_onset"]),
+    (["--motion", "grip_bending_onset"], ["--motion", "SETTING=V1,V2"]),
+    (["--motion", "replan_beyond_m=0.02"], ["--motion", "use --replan-beyond"]),
+    (["--motion", "grip_bending_onset=0.3", "--loop", "open"], ["--motion",
+                                                                "closed loop only"]),
+    (["--motion", "grip_bending_onset=0.3", "--motion", "grip_bending_onset=0.2"],
+     ["grip_bending_onset given twice"]),
 ])
 def test_bad_flags_exit_2_naming_the_option(argv, words, tmp_path, capsys):
     assert main([*argv, "--out", str(tmp_path)]) == 2
@@ -134,6 +145,30 @@ def test_re_planning_closed_runs_get_their_own_row_and_fingerprint(tmp_path):
     assert "replan_beyond_m" not in jobs[0].describe()
 
 
+def test_motion_settings_repeat_each_closed_run_on_the_same_draws(tmp_path):
+    """``--motion`` makes one closed run per setting value, each in its own row, on the
+    draws that the other values and the open run see; the settings reach the job and its
+    fingerprint, and crossing two flags makes every combination."""
+    labels, runs = _both_loops(tmp_path / "o", "--perturb", "placement=0.03",
+                               "--motion", "grip_bending_onset=0,0.35",
+                               "--motion", "gravity_compensation=off")
+    assert labels == ["mixed closed, grip_bending_onset=0, gravity_compensation=off",
+                      "mixed closed, grip_bending_onset=0.35, gravity_compensation=off",
+                      "mixed open"]
+    seed1 = sorted((r for r in runs if r["seed"] == 1), key=lambda r: r["key"])
+    assert [(r["loop"], r.get("motion")) for r in seed1] == [
+        ("closed", {"grip_bending_onset": 0.0, "gravity_compensation": False}),
+        ("closed", {"grip_bending_onset": 0.35, "gravity_compensation": False}),
+        ("open", None)]
+    for seed in (1, 2):
+        draws = [r["perturbation"] for r in runs if r["seed"] == seed]
+        assert len(draws) == 3 and draws[0] == draws[1] == draws[2]
+    jobs = expand_jobs([("drc", load_ladder("drc"), {})], [1], ["mixed"], parse_perturb(""),
+                       motion_variants=[(), (("grip_bending_onset", 0.35),)])[1]
+    assert len({j.fingerprint for j in jobs}) == len({j.key for j in jobs}) == 2
+    assert "motion" not in jobs[0].describe()
+
+
 def test_small_sweep_run_writes_a_heat_map(tmp_path):
     sweep = tmp_path / "s.yaml"
     sweep.write_text("base: drc\nmode: grid\nparameters:\n  slope_deg: [50, 60, 70]\n"
@@ -191,6 +226,7 @@ def test_real_plan_and_validate_on_the_stair_first_rung(tmp_path, capsys):
     out = tmp_path / "real"
     code = main(["--ladders", "stair", "--top-rung", "0", "--seeds", "1", "--perturb",
                  "placement=0.01", "--replan-beyond", "0.05", "--workers", "2",
+                 "--motion", "grip_bending_onset=0.3",
                  "--out", str(out), "--no-plots"])
     text = capsys.readouterr().out
     assert code == 0, text
@@ -204,7 +240,9 @@ def test_real_plan_and_validate_on_the_stair_first_rung(tmp_path, capsys):
         if plan["outcome"] == "planned":
             # the record carries validate-plan's own result: cause, why and metrics
             assert r["result"]["strategy"] == r["strategy"]
-            assert r["result"]["replan_beyond_m"] == 0.05  # the motion layer got the option
+            assert r["result"]["replan_beyond_m"] == 0.05  # the motion layer got the options
+            assert r["result"]["motion_settings"] == {"replan_beyond_m": 0.05,
+                                                      "grip_bending_onset": 0.3}
             assert r["result"]["placement_error"]["dx_m"] == r["perturbation"]["dx_m"]
             assert r["outcome"] == "climbed" or r["cause"] in causes
             assert r["why"] and r["simulated_s"] > 0

@@ -2,6 +2,7 @@
 
     batch-eval [--ladders drc,ship,stair | --sweep SWEEP.yaml] [--seeds N] [--first-seed S]
                [--strategies mixed,position,pwm] [--loop closed,open] [--replan-beyond M]
+               [--motion SETTING=V1,V2 ...]
                [--perturb KEY=V,...] [--draws D]
                [--engine local|dask] [--address tcp://host:8786] [--workers K]
                [--out DIR] [--plans-from DIR] [--time-limit S] [--top-rung K] [--robot R]
@@ -9,7 +10,8 @@
 
 Per (ladder, seed) one plan (seeds S..S+N−1), then per strategy × loop × perturbation
 draw one simulated climb of that plan (closed loop through the motion layer, open loop
-as the file is; both loops of a strategy see the same draws) (`execute.batch.jobs`; perturbations:
+as the file is; both loops of a strategy see the same draws; ``--motion`` repeats every
+closed run per motion-layer setting, on the same draws) (`execute.batch.jobs`; perturbations:
 `execute.batch.perturb`; sweeps: `execute.batch.sweep`). Jobs run on a local process
 pool or a Dask cluster (`execute.batch.engine`). Every finished job is appended to
 ``DIR/results.jsonl``; running the same command again skips finished jobs and retries
@@ -26,6 +28,7 @@ and line); 130 interrupted (rerun to resume).
 from __future__ import annotations
 
 import argparse
+import itertools
 import logging
 import math
 import os
@@ -33,7 +36,7 @@ import sys
 import time
 from pathlib import Path
 
-from execute.motion.config import MotionConfig, MotionConfigError
+from execute.motion.config import SETTINGS, MotionConfig, MotionConfigError, parse_setting
 from robot.constants import DAEMON_RATE_HZ
 from robot.errors import HuboLadderError, InputError, run_cli
 from robot.vocabulary import ArmStrategy
@@ -67,6 +70,11 @@ def _parser() -> argparse.ArgumentParser:
                         "than M from the real ones, plan again for the ladder where the hands "
                         "found it and climb that plan (validate-plan --replan-beyond); within "
                         "[0, 0.2], 0 never (default 0)")
+    p.add_argument("--motion", action="append", default=[], metavar="SETTING=V1,V2",
+                   help="closed loop: run each closed run once per value of this motion-layer "
+                        "setting (a MotionConfig field, e.g. grip_bending_onset=0,0.35); "
+                        "repeat the flag to cross settings; every variant sees the same "
+                        "draws and gets its own row")
     p.add_argument("--perturb", default="", metavar="KEY=V,...",
                    help="placement=M,yaw=RAD,rung=M,friction=LO:HI,battery=LO:HI")
     p.add_argument("--draws", type=int, default=1, metavar="D",
@@ -110,7 +118,8 @@ def parse_args(argv: list[str] | None = None) -> dict:
 
     Returns:
         A dict with ``ladders`` ([(key, spec, sweep values)]), ``seeds``, ``strategies``,
-        ``loops``, ``replan_beyond_m``, ``perturb`` (`PerturbSpec`), ``draws``,
+        ``loops``, ``replan_beyond_m``, ``motion_variants`` (`_motion_variants`),
+        ``perturb`` (`PerturbSpec`), ``draws``,
         ``engine``, ``address``, ``workers``, ``out``, ``plans_from``, ``time_limit_s``,
         ``top_rung``, ``robot``, ``rate_hz``, ``max_jobs``, ``plots``, ``verbose``.
 
@@ -135,6 +144,10 @@ def parse_args(argv: list[str] | None = None) -> dict:
     if a.replan_beyond and "closed" not in loops:
         raise InputError(f"option --replan-beyond is {a.replan_beyond:g}, but --loop is "
                          f"{a.loop!r}: only closed-loop runs plan again")
+    motion_variants = _motion_variants(a.motion)
+    if a.motion and "closed" not in loops:
+        raise InputError(f"option --motion is given, but --loop is {a.loop!r}: the motion "
+                         "layer runs in closed loop only")
     perturb = parse_perturb(a.perturb)
     if a.draws > 1 and not perturb:
         raise InputError(f"option --draws is {a.draws}, but there is no --perturb: every draw "
@@ -151,12 +164,39 @@ def parse_args(argv: list[str] | None = None) -> dict:
     workers = a.workers or os.cpu_count() or 1
     return {"ladders": ladders, "seeds": list(range(a.first_seed, a.first_seed + a.seeds)),
             "strategies": strategies, "loops": loops, "replan_beyond_m": a.replan_beyond,
+            "motion_variants": motion_variants,
             "perturb": perturb, "draws": a.draws,
             "engine": a.engine, "address": a.address, "workers": workers, "out": Path(a.out),
             "plans_from": None if a.plans_from is None else Path(a.plans_from),
             "time_limit_s": a.time_limit, "top_rung": a.top_rung, "robot": a.robot,
             "rate_hz": a.rate, "max_jobs": a.max_jobs, "plots": not a.no_plots,
             "verbose": a.verbose}
+
+
+def _motion_variants(flags: list[str]) -> list[tuple[tuple[str, object], ...]]:
+    """Every combination of the ``--motion SETTING=V1,V2`` flags' values, in flag order
+    (one empty variant when none is given)."""
+    axes: list[list[tuple[str, object]]] = []
+    names: list[str] = []
+    for flag in flags:
+        name, eq, values = flag.partition("=")
+        name = name.strip()
+        if not eq or not values.strip():
+            raise InputError(f"option --motion {flag!r}: give SETTING=V1,V2 (settings: "
+                             f"{', '.join(s for s in SETTINGS if s != 'replan_beyond_m')})")
+        if name == "replan_beyond_m":
+            raise InputError("option --motion replan_beyond_m: use --replan-beyond, which "
+                             "also plans again")
+        if name in names:
+            raise InputError(f"option --motion: {name} given twice; list its values in one "
+                             "flag")
+        names.append(name)
+        try:
+            axes.append([(name, parse_setting(name, v))
+                         for v in _split(f"--motion {name}", values)])
+        except InputError as exc:
+            raise InputError(f"option --motion: {exc}") from None
+    return list(itertools.product(*axes))
 
 
 def _check_scalar_options(a: argparse.Namespace) -> None:
@@ -231,7 +271,8 @@ def run(opts: dict, console, err, functions=None, engine=None) -> int:
                                      time_limit_s=opts["time_limit_s"],
                                      top_rung=opts["top_rung"], rate_hz=opts["rate_hz"],
                                      loops=opts["loops"],
-                                     replan_beyond_m=opts.get("replan_beyond_m", 0.0))
+                                     replan_beyond_m=opts.get("replan_beyond_m", 0.0),
+                                     motion_variants=opts.get("motion_variants", [()]))
     out: Path = opts["out"]
     out.mkdir(parents=True, exist_ok=True)
     if opts.get("plans_from") is not None:
@@ -300,7 +341,6 @@ def _run_with_progress(plans, validations, opts: dict, err, functions, engine):
 def _write_reports(batch, plans, validations, opts: dict, console) -> list[Path]:
     """The success table: printed, ``summary.csv``, ``summary.md`` and (unless
     ``--no-plots``) the plots; returns the files written."""
-    from execute.batch.jobs import run_label
     from execute.batch.report import (
         print_summary,
         summarize_records,
@@ -316,10 +356,9 @@ def _write_reports(batch, plans, validations, opts: dict, console) -> list[Path]
     expected_plans: dict[str, int] = {}
     for p in plans:
         expected_plans[p.ladder_key] = expected_plans.get(p.ladder_key, 0) + 1
+    labels = list(dict.fromkeys(v.label for v in validations))  # strategy, loop, variant
     summary = summarize_records(batch.records, {k: s for k, s, _ in opts["ladders"]},
-                                [run_label(s, lp, opts.get("replan_beyond_m", 0.0))
-                                 for s in opts["strategies"]
-                                 for lp in opts["loops"]], expected, expected_plans)
+                                labels, expected, expected_plans)
     print_summary(summary, console)
     files = [write_csv(summary, out / "summary.csv"), write_markdown(summary, out / "summary.md")]
     if opts["plots"]:

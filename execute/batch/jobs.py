@@ -115,6 +115,8 @@ class ValidateJob:
         replan_beyond_m: closed loop: plan again after the first two grasps when they find
             a hold further than this from the plan's [m] (`MotionConfig.replan_beyond_m`;
             0 never).
+        motion: closed loop: (field, value) settings of the motion layer that this run
+            sets (`batch-eval --motion`); the others keep their defaults.
     """
 
     plan: PlanJob
@@ -123,20 +125,25 @@ class ValidateJob:
     draw: Draw
     loop: str = "closed"
     replan_beyond_m: float = 0.0
+    motion: tuple[tuple[str, Any], ...] = ()
 
     kind = "validate"
 
     @property
     def key(self) -> str:
+        settings = "".join(f"/{name}={value}" for name, value in self.motion)
         return f"validate/{self.plan.ladder_key}/s{self.plan.seed}/{self.strategy}/" \
-               f"{self.loop}/d{self.draw_index}"
+               f"{self.loop}{settings}/d{self.draw_index}"
 
     @property
     def fingerprint(self) -> str:
         identity = {"kind": "validate", "plan": self.plan.fingerprint,
                     "strategy": self.strategy, "loop": self.loop, "draw": self.draw.to_json()}
-        if self.replans:  # absent when off, so batches from before the option still resume
+        # each option is absent when unused, so batches from before it still resume
+        if self.replans:
             identity["replan_beyond_m"] = self.replan_beyond_m
+        if self.motion:
+            identity["motion"] = dict(self.motion)
         return _fingerprint(identity)
 
     @property
@@ -150,37 +157,48 @@ class ValidateJob:
                 "sweep": dict(self.plan.sweep), "strategy": self.strategy,
                 "loop": self.loop, "draw": self.draw_index,
                 "perturbation": self.draw.to_json()} | (
-                    {"replan_beyond_m": self.replan_beyond_m} if self.replans else {})
+                    {"replan_beyond_m": self.replan_beyond_m} if self.replans else {}) | (
+                    {"motion": dict(self.motion)} if self.motion else {})
 
     @property
     def label(self) -> str:
         """The row of the summary this run counts in."""
         return run_label(self.strategy, self.loop,
-                         self.replan_beyond_m if self.replans else 0.0)
+                         self.replan_beyond_m if self.replans else 0.0, dict(self.motion))
 
 
-def run_label(strategy: str, loop: str, replan_beyond_m: float = 0.0) -> str:
+def run_label(strategy: str, loop: str, replan_beyond_m: float = 0.0,
+              motion: dict[str, Any] | None = None) -> str:
     """``"mixed closed"``: a strategy played open or closed loop;
     ``"mixed closed, re-plan > 2 cm"`` when a closed run may plan again after its first
-    touch."""
+    touch; ``"mixed closed, grip_bending_onset=0.35"`` with motion-layer settings."""
     label = f"{strategy} {loop}"
     if loop == "closed" and replan_beyond_m > 0:
         label += f", re-plan > {replan_beyond_m * 100:g} cm"
+    for name, value in (motion or {}).items():
+        label += f", {name}={_setting_text(value)}"
     return label
+
+
+def _setting_text(value: Any) -> str:
+    if isinstance(value, bool):
+        return "on" if value else "off"
+    return f"{value:g}"
 
 
 def record_label(record: dict) -> str:
     """The summary row of a validate record (records written before the loop axis
     existed were open loop)."""
     return run_label(record["strategy"], record.get("loop", "open"),
-                     record.get("replan_beyond_m", 0.0))
+                     record.get("replan_beyond_m", 0.0), record.get("motion"))
 
 
 def expand_jobs(ladders: Sequence[tuple[str, LadderSpec, dict[str, Any]]], seeds: Sequence[int],
                 strategies: Sequence[str], perturb: PerturbSpec, draws: int = 1, *,
                 robot: str = "drc-hubo", time_limit_s: float = 600.0,
                 top_rung: int | None = None, rate_hz: float = DAEMON_RATE_HZ,
-                loops: Sequence[str] = ("closed",), replan_beyond_m: float = 0.0
+                loops: Sequence[str] = ("closed",), replan_beyond_m: float = 0.0,
+                motion_variants: Sequence[tuple[tuple[str, Any], ...]] = ((),)
                 ) -> tuple[list[PlanJob], list[ValidateJob]]:
     """Every job of a batch.
 
@@ -193,9 +211,12 @@ def expand_jobs(ladders: Sequence[tuple[str, LadderSpec, dict[str, Any]]], seeds
         robot, time_limit_s, top_rung, rate_hz: planning settings (see `PlanJob`).
         loops: ``closed`` and/or ``open``; both loops of a strategy see the same draws.
         replan_beyond_m: closed runs plan again beyond this first-touch error [m] (0 never).
+        motion_variants: the closed runs' motion-layer settings (`ValidateJob.motion`):
+            every closed run is made once per variant, each on the same draws; an open
+            run, which has no motion layer, once.
 
     Returns:
-        (plan jobs, validate jobs), in ladder, seed, strategy, loop, draw order.
+        (plan jobs, validate jobs), in ladder, seed, strategy, loop, variant, draw order.
     """
     plans, validations = [], []
     for key, spec, sweep in ladders:
@@ -205,10 +226,11 @@ def expand_jobs(ladders: Sequence[tuple[str, LadderSpec, dict[str, Any]]], seeds
             plans.append(p)
             for strategy in strategies:
                 for loop in loops:
-                    for i in range(draws):
-                        validations.append(ValidateJob(
-                            p, strategy, i, draw(perturb, key, int(seed), strategy, i), loop,
-                            replan_beyond_m))
+                    for motion in (motion_variants if loop == "closed" else ((),)):
+                        for i in range(draws):
+                            validations.append(ValidateJob(
+                                p, strategy, i, draw(perturb, key, int(seed), strategy, i),
+                                loop, replan_beyond_m, tuple(motion)))
     return plans, validations
 
 
@@ -293,7 +315,8 @@ def validate_job(job: ValidateJob, plan_outcome: dict, out_dir: str) -> dict:
                              placement=PlacementError(d.dx_m, d.dy_m, d.dyaw_rad),
                              board=BoardModelConfig(battery_v=d.battery_v), record_qpos=False,
                              closed_loop=job.loop == "closed",
-                             motion=MotionConfig(replan_beyond_m=job.replan_beyond_m))
+                             motion=MotionConfig(replan_beyond_m=job.replan_beyond_m,
+                                                 **dict(job.motion)))
     run = simulate(traj, sidecar, d.physical_ladder(job.plan.ladder), opts, sidecar.robot)
     metrics = compute_metrics(run)
     result = result_json(run, metrics, plan_outcome["traj"],

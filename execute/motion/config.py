@@ -8,7 +8,8 @@ from dataclasses import dataclass, field
 
 from robot.errors import InputError
 
-__all__ = ["EstimatorConfig", "MotionConfig", "MotionConfigError", "default_config"]
+__all__ = ["SETTINGS", "EstimatorConfig", "MotionConfig", "MotionConfigError", "default_config",
+           "parse_setting"]
 
 
 class MotionConfigError(InputError):
@@ -188,9 +189,51 @@ class MotionConfig:
             if not (isinstance(value, (int, float)) and math.isfinite(value) and lo <= value <= hi):
                 raise MotionConfigError(name, value, (lo, hi))
 
+    def changed_settings(self) -> dict[str, bool | int | float]:
+        """The `SETTINGS` whose value is not the default, for a run's record."""
+        default = MotionConfig()
+        return {name: getattr(self, name) for name in SETTINGS
+                if getattr(self, name) != getattr(default, name)}
+
 
 def default_config() -> MotionConfig:
     return MotionConfig()
+
+
+#: The settings a batch may vary (`parse_setting`): every ranged field and the switch.
+SETTINGS: tuple[str, ...] = ("gravity_compensation", *_RANGES)
+
+_SWITCH_WORDS = {"on": True, "true": True, "1": True, "off": False, "false": False, "0": False}
+
+
+def parse_setting(name: str, text: str) -> bool | int | float:
+    """A `MotionConfig` field's value from text, typed as its default and checked against
+    its range.
+
+    Args:
+        name: one of `SETTINGS`.
+        text: ``on``/``off`` for a switch, an integer for a count, a number otherwise.
+
+    Raises:
+        InputError: an unknown field or a value that does not parse.
+        MotionConfigError: a value outside the field's range.
+    """
+    if name not in SETTINGS:
+        raise InputError(f"motion layer setting {name!r} is unknown; known: "
+                         f"{', '.join(SETTINGS)}")
+    default = getattr(MotionConfig(), name)
+    word = text.strip().lower()
+    if isinstance(default, bool):
+        if word not in _SWITCH_WORDS:
+            raise InputError(f"motion layer {name} = {text!r}: give on or off")
+        return _SWITCH_WORDS[word]
+    try:
+        value: int | float = int(word) if isinstance(default, int) else float(word)
+    except ValueError:
+        kind = "an integer" if isinstance(default, int) else "a number"
+        raise InputError(f"motion layer {name} = {text!r}: give {kind}") from None
+    MotionConfig(**{name: value})
+    return value
 
 
 def add_motion_arguments(parser: argparse.ArgumentParser) -> None:

@@ -179,6 +179,8 @@ def result_json(run, metrics, plan_path: str, comparison=None) -> dict:
         "motion": run.motion,
         "replan_beyond_m": (run.options.motion.replan_beyond_m if run.options.closed_loop
                             else None),
+        "motion_settings": (run.options.motion.changed_settings() if run.options.closed_loop
+                            else None),
         "replan": run.replan,
     }
 
