@@ -161,22 +161,6 @@ def _write_plots(args: argparse.Namespace, result, planner, spec, out, err, on_o
         err.print(f"plan-ladder: no snapshot strip: {exc}", markup=False)
 
 
-def _no_plan_message(exc, planner, spec, current, time_limit_s: float) -> str:
-    """The user's ``no plan:`` message for a `PlanningFailed` or `TimeLimitExceeded`
-    (`planner.failure_report`); the search's own text, with the solver's figures, is
-    logged at ``-v``."""
-    from planner.search import PlanningFailed
-
-    log.info("search stopped: %s", exc)
-    if isinstance(exc, PlanningFailed):
-        progress, stop = exc.progress, exc.stop
-    else:
-        progress, stop = planner.progress, f"time limit of {time_limit_s:g} s reached"
-    if progress is None:  # stopped before the search began
-        return f"no plan: {current.primitive.name} at rung {current.rung}: {stop}"
-    return progress.explain(spec, stop)
-
-
 def _plan(args: argparse.Namespace, err) -> int:
     from ladders.loader import load_ladder
     from planner.output import write_plan
@@ -210,10 +194,8 @@ def _plan(args: argparse.Namespace, err) -> int:
     out_path = Path(args.out) if args.out else Path(f"{spec.name}.traj")
     search = ProgressReporter("plan-ladder", "search: steps", len(steps), console=err)
     search.update(0, note=f"{steps[0].label} (rung 0 of {top})")
-    current = [steps[0]]  # the step being searched, for the time-out message
-
     def on_step(i: int, n: int, step, stats) -> None:
-        current[0] = nxt = steps[min(i + 1, n - 1)]
+        nxt = steps[min(i + 1, n - 1)]
         search.update(i + 1, note=f"{nxt.label} (rung {nxt.rung} of {top})" if i + 1 < n
                       else "all steps found")
         log.info("%s done: %.2f s, %d samples, %d backtracks", step.label, stats.seconds,
@@ -224,7 +206,7 @@ def _plan(args: argparse.Namespace, err) -> int:
             result = planner.plan(top_rung=top, progress=on_step)
     except (PlanningFailed, TimeLimitExceeded) as exc:
         search.finish("no plan")
-        err.print(_no_plan_message(exc, planner, spec, current[0], args.time_limit),
+        err.print(planner.no_plan_message(exc, args.time_limit),
                   markup=False, highlight=False, soft_wrap=True)
         return 1
     # Not "done": timing, checking and writing the plan may take minutes more.

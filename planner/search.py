@@ -39,6 +39,7 @@ from planner.paths.limb_path import foot_waypoints, hand_waypoints
 from planner.paths.limb_rrt import plan_limb_path
 from planner.reachability import check_reach
 from planner.statics.arm_capacity import DEFAULT_ARM_STRATEGY, DEFAULT_POSITION_TORQUE_SHARE
+from planner.time_limit import TimeLimitExceeded
 from primitives.hold_seeds import FloorSeed, RailSeed
 from primitives.library import climb_sequence
 from primitives.primitive import Step
@@ -315,6 +316,21 @@ class ClimbPlanner:
         self.ik_waypoint_config = IKConfig(
             moving_tol_m=self.ik_config.waypoint_tol_m,
             moving_angle_tol_rad=self.ik_config.waypoint_angle_tol_rad)
+
+    def no_plan_message(self, exc: PlanningFailed | TimeLimitExceeded,
+                        time_limit_s: float) -> str:
+        """The user's ``no plan:`` message for a search that stopped with ``exc``
+        (`planner.failure_report`): the deepest step reached and its reasons in user
+        terms; the search's own text, with the solver's figures, is only logged."""
+        log.info("search stopped: %s", exc)
+        if isinstance(exc, PlanningFailed):
+            if exc.progress is None:
+                return f"no plan: {exc.step.primitive.name} at rung {exc.step.rung}: {exc.stop}"
+            return exc.progress.explain(self.spec, exc.stop)
+        stop = f"time limit of {time_limit_s:g} s reached"
+        if self.progress is None:
+            return f"no plan: {stop} before the search began"
+        return self.progress.explain(self.spec, stop)
 
     # ----------------------------------------------------------------------------------
     def start_configuration(self) -> tuple[np.ndarray, Stance]:

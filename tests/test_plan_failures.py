@@ -114,3 +114,17 @@ def test_cli_no_plan_is_in_user_terms_and_internals_need_v(tmp_path, capsys):
     assert IK_TEXT not in err
     assert main(argv + ["-v"]) == 1
     assert IK_TEXT in capsys.readouterr().err
+
+
+def test_batch_eval_s_no_plan_is_plan_ladder_s_message(tmp_path):
+    """A batch's no-plan record explains the failure as plan-ladder does; the search's
+    own text is kept apart, under ``search_reason``."""
+    from execute.batch.jobs import PlanJob, plan_job
+
+    spec = load_ladder(str(_steep_ladder(tmp_path)))
+    outcome = plan_job(PlanJob("steep", spec, 1, time_limit_s=60.0), str(tmp_path))
+    assert outcome["outcome"] == "no_plan" and outcome["where"] == "placeHands at rung 0"
+    assert outcome["why"].startswith("no plan: placeHands at rung 0 (left hand onto the left "
+                                     "rail, right hand onto the right rail)")
+    assert "rails 0.62 m apart" in outcome["why"] and IK_TEXT not in outcome["why"]
+    assert IK_TEXT in outcome["search_reason"]

@@ -11,8 +11,9 @@ files, which the plan job writes under ``OUT/plans/`` (with a remote Dask cluste
 A job function returns a JSON-able dict, the job's *outcome*:
 
 - plan: ``outcome`` ``planned`` (``traj``, ``plan_s``, ``motion_s``, ``top_rung``) or
-  ``no_plan`` (``cause`` ``no_plan``, ``why`` naming the primitive and rung, or the
-  timing error);
+  ``no_plan`` (``cause`` ``no_plan``; ``why``: plan-ladder's message, the deepest step
+  reached and its reasons in user terms, or the timing error; ``search_reason``: the
+  search's own text, with the solver's figures);
 - validate: ``outcome`` ``climbed`` or ``failed`` with ``cause`` and ``why`` from
   `execute.validate.verdict`, the simulated time and the metrics of
   `execute.validate.metrics`; the whole `execute.validate.cli.result_json` record is kept
@@ -266,12 +267,13 @@ def plan_job(job: PlanJob, out_dir: str) -> dict:
             result = planner.plan(top_rung=top)
     except PlanningFailed as exc:
         where = f"{exc.step.primitive.name} at rung {exc.step.rung}"
-        return {**_NO_PLAN, "plan_s": time.perf_counter() - t0,
-                "top_rung": top, "where": where, "why": f"{where}: {exc.reason}"}
-    except TimeLimitExceeded:
+        return {**_NO_PLAN, "plan_s": time.perf_counter() - t0, "top_rung": top,
+                "where": where, "why": planner.no_plan_message(exc, job.time_limit_s),
+                "search_reason": f"{where}: {exc.reason}"}
+    except TimeLimitExceeded as exc:
         return {**_NO_PLAN, "plan_s": time.perf_counter() - t0,
                 "top_rung": top, "where": "time limit",
-                "why": f"time limit of {job.time_limit_s:g} s reached"}
+                "why": planner.no_plan_message(exc, job.time_limit_s)}
     search_s = time.perf_counter() - t0
     out = Path(out_dir) / job.traj_name
     out.parent.mkdir(parents=True, exist_ok=True)
