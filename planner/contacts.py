@@ -11,6 +11,7 @@ both with friction μ (the CoM tests of `planner.statics.com_region` still take 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -20,6 +21,8 @@ from robot.vocabulary import LIMBS, Limb  # noqa: F401  (LIMBS re-exported)
 #: Operational frame of each limb in the robot model.
 LIMB_FRAME = {"left_hand": "L_palm", "right_hand": "R_palm", "left_foot": "L_sole",
               "right_foot": "R_sole"}
+#: The hands' limb names: `Hold.is_hand` is asked hundreds of thousands of times a search.
+_HANDS = frozenset(limb.value for limb in Limb if limb.is_hand)
 
 
 @dataclass(frozen=True)
@@ -46,13 +49,23 @@ class Hold:
     friction: float = 0.4
     limits: HandLimits | FootPatch | None = field(default=None, repr=False)
 
+    def __post_init__(self) -> None:
+        Limb(self.limb)  # a ValueError naming an unknown limb
+
     @property
     def frame(self) -> str:
         return LIMB_FRAME[self.limb]
 
     @property
     def is_hand(self) -> bool:
-        return Limb(self.limb).is_hand
+        return self.limb in _HANDS
+
+    @cached_property
+    def points_in_frame_m(self) -> np.ndarray:
+        """The contact points in the coordinates of the limb frame at its hold [m]: a
+        search's torque LPs place them thousands of times."""
+        t_inv = np.linalg.inv(self.T_world_frame)
+        return self.points_m @ t_inv[:3, :3].T + t_inv[:3, 3]
 
     def __repr__(self) -> str:
         p = self.T_world_frame[:3, 3]

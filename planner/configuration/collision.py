@@ -193,8 +193,11 @@ class CollisionModel:
     def colliding_pairs(self, q: np.ndarray) -> list[tuple[str, str]]:
         pin.computeCollisions(self.kin.model, self.kin.data, self.geom, self.gdata, q, False)
         out = []
-        for k, cp in enumerate(self.geom.collisionPairs):
-            if self.gdata.activeCollisionPairs[k] and self.gdata.collisionResults[k].isCollision():
+        # Results first: reading a pair's flags through the bindings costs microseconds, and
+        # a few of the ~700 pairs collide. An inactive pair keeps a stale result.
+        for k, result in enumerate(self.gdata.collisionResults):
+            if result.isCollision() and self.gdata.activeCollisionPairs[k]:
+                cp = self.geom.collisionPairs[k]
                 out.append((self.geom.geometryObjects[cp.first].name,
                             self.geom.geometryObjects[cp.second].name))
         return out

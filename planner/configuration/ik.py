@@ -100,7 +100,9 @@ AXIS_ALIGN_NUDGE_RAD = 1e-6
 def _axis_target(current: np.ndarray, target: np.ndarray) -> np.ndarray:
     """``target``, turned by `AXIS_ALIGN_NUDGE_RAD` if it is exactly (anti)parallel to the
     frame's ``current`` axis (both unit vectors)."""
-    if np.linalg.norm(np.cross(current, target)) > 1e-12:
+    # Scalar cross product (np.cross's per-call overhead was 6 % of a search).
+    (a0, a1, a2), (b0, b1, b2) = current.tolist(), target.tolist()
+    if math.hypot(a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0) > 1e-12:
         return target
     perpendicular = np.cross(target, np.eye(3)[int(np.argmin(np.abs(target)))])
     perpendicular /= np.linalg.norm(perpendicular)
@@ -108,18 +110,42 @@ def _axis_target(current: np.ndarray, target: np.ndarray) -> np.ndarray:
             + np.sin(AXIS_ALIGN_NUDGE_RAD) * perpendicular)
 
 
-def _hold_error(kin: HuboKinematics, limb_frame: str, T_target: np.ndarray,
-                is_hand: bool) -> tuple[float, float]:
-    # Scalar math (the same arithmetic as np.linalg.norm and np.clip): this runs ~30 times
-    # per IK solve, and numpy's per-call overhead was most of its cost.
-    T = kin.wrapper.get_T_world_frame(limb_frame)
-    d = T[:3, 3] - T_target[:3, 3]
-    dp = math.sqrt(float(d @ d))
-    if is_hand:  # only the grip axis is constrained
-        c = float(T[:3, 0] @ T_target[:3, 0])
-    else:
-        c = float((np.trace(T[:3, :3].T @ T_target[:3, :3]) - 1) / 2)
-    return dp, float(np.arccos(min(max(c, -1.0), 1.0)))
+class _HoldCheck(NamedTuple):
+    """What an IK iteration measures of one hold, taken from it once per solve: every
+    iteration checks every hold, hundreds of thousands of times in a search."""
+
+    hold: Hold
+    frame: str
+    target: tuple[tuple[float, ...], ...]  # the target pose's top three rows
+    is_hand: bool
+    position_tol_m: float
+    angle_tol_rad: float
+
+
+def _hold_checks(support, moving, config: IKConfig) -> tuple[_HoldCheck, ...]:
+    """The holds' checks, supporting holds first, each with its tolerances."""
+    return tuple(_HoldCheck(h, h.frame, tuple(map(tuple, h.T_world_frame[:3].tolist())),
+                            h.is_hand, tol, atol)
+                 for holds, tol, atol in ((support, config.position_tol_m, config.angle_tol_rad),
+                                          (moving, config.moving_tol_m,
+                                           config.moving_angle_tol_rad))
+                 for h in holds)
+
+
+def _hold_error(kin: HuboKinematics, check: _HoldCheck) -> tuple[float, float]:
+    """The frame's distance from its target [m] and its turn from it [rad]: a hand's grip
+    axis (x), the only axis its hold constrains, or a foot's whole orientation."""
+    # Scalar math on Python floats: this runs every IK iteration for every hold, half a
+    # million times a search, and numpy's per-call overhead was most of its cost.
+    (a00, a01, a02, ax), (a10, a11, a12, ay), (a20, a21, a22, az) = \
+        kin.wrapper.get_T_world_frame(check.frame)[:3].tolist()
+    (b00, b01, b02, bx), (b10, b11, b12, by), (b20, b21, b22, bz) = check.target
+    dp = math.sqrt((ax - bx) ** 2 + (ay - by) ** 2 + (az - bz) ** 2)
+    c = a00 * b00 + a10 * b10 + a20 * b20  # cos of the turn between the x axes
+    if not check.is_hand:  # (trace(R_a^T R_b) - 1) / 2
+        c = (c + a01 * b01 + a11 * b11 + a21 * b21 + a02 * b02 + a12 * b12 + a22 * b22
+             - 1.0) / 2.0
+    return dp, math.acos(min(max(c, -1.0), 1.0))
 
 
 def solve_ik(kin: HuboKinematics, q_seed: np.ndarray, support: tuple[Hold, ...],
@@ -182,6 +208,7 @@ def solve_ik(kin: HuboKinematics, q_seed: np.ndarray, support: tuple[Hold, ...],
         # step. Stability is verified on the result anyway.
         cc.configure("com_polygon", "soft", config.com_polygon_weight)
     solver.add_regularization_task(config.regularization)
+    checks = _hold_checks(support, moving, config)
     it = 0
     pos_err = ang_err = np.inf
     for it in range(1, config.max_iterations + 1):
@@ -189,10 +216,10 @@ def solve_ik(kin: HuboKinematics, q_seed: np.ndarray, support: tuple[Hold, ...],
         if not _solve_widening_step(solver, config, it):
             break
         robot.update_kinematics()
-        pos_err, ang_err, ok = _errors(kin, support, moving, config)
+        pos_err, ang_err, ok = _errors(kin, checks)
         if ok and it > 2:
             break
-    final = list(_each_hold_error(kin, support, moving, config))
+    final = list(_each_hold_error(kin, checks))
     converged = bool(np.isfinite(pos_err)) and all(met for *_, met in final)
     misses = () if converged else tuple(HoldMiss(h.limb, h.target, dp, da)
                                         for h, dp, da, met in final if not met)
@@ -216,21 +243,19 @@ def _solve_widening_step(solver, config: IKConfig, iteration: int) -> bool:
             solver.dt *= 2
 
 
-def _each_hold_error(kin: HuboKinematics, support, moving, config: IKConfig):
+def _each_hold_error(kin: HuboKinematics, checks: tuple[_HoldCheck, ...]):
     """Per hold (supporting ones first): the hold, its position [m] and angle [rad] errors
     and whether both are within its tolerance."""
-    for holds, tol, atol in ((support, config.position_tol_m, config.angle_tol_rad),
-                             (moving, config.moving_tol_m, config.moving_angle_tol_rad)):
-        for h in holds:
-            dp, da = _hold_error(kin, h.frame, h.T_world_frame, h.is_hand)
-            yield h, dp, da, dp < tol and da < atol
+    for check in checks:
+        dp, da = _hold_error(kin, check)
+        yield check.hold, dp, da, dp < check.position_tol_m and da < check.angle_tol_rad
 
 
-def _errors(kin: HuboKinematics, support, moving, config: IKConfig) -> tuple[float, float, bool]:
+def _errors(kin: HuboKinematics, checks: tuple[_HoldCheck, ...]) -> tuple[float, float, bool]:
     """Worst position and angle errors, and whether every hold meets its tolerance."""
     ok = True
     pos_err = ang_err = 0.0
-    for _, dp, da, met in _each_hold_error(kin, support, moving, config):
+    for _, dp, da, met in _each_hold_error(kin, checks):
         ok &= met
         pos_err, ang_err = max(pos_err, dp), max(ang_err, da)
     return pos_err, ang_err, ok

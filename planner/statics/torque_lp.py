@@ -308,9 +308,8 @@ def _contact_columns(model, data, stance: Stance, frame_ids: Mapping[str, int] |
             cost_parts.append(np.tile(GRIP_LOAD_COST * weight_n / per, 2))
             parts.append((hold, o_m_f.rotation.copy(), None, None))
             continue
-        t_inv = np.linalg.inv(hold.T_world_frame)
-        pts_local = hold.points_m @ t_inv[:3, :3].T + t_inv[:3, 3]
-        r = pts_local @ o_m_f.rotation.T  # world-frame offsets from the frame origin [m]
+        # world-frame offsets of the points from the frame's origin [m]
+        r = hold.points_in_frame_m @ o_m_f.rotation.T
         e = cone_edges_cached(np.ascontiguousarray(hold.normals, dtype=float).tobytes(),
                               float(hold.friction), cfg.cone_edges)  # (m, k, 3)
         k = e.shape[1]

@@ -158,8 +158,7 @@ class StanceLines:
                 self.holds.append(_Hold(hold.limb, frame.parentJoint, frame.placement.rotation,
                                         frame.placement.translation, hold.limits, None, None))
             else:
-                t_inv = np.linalg.inv(hold.T_world_frame)
-                pts = hold.points_m @ t_inv[:3, :3].T + t_inv[:3, 3]
+                pts = hold.points_in_frame_m
                 e = cone_edges_cached(np.ascontiguousarray(hold.normals, dtype=float).tobytes(),
                                       float(hold.friction), cfg.cone_edges)
                 costs.append(np.zeros(e.shape[0] * e.shape[1]))
