@@ -188,9 +188,8 @@ def solve_ik(kin: HuboKinematics, q_seed: np.ndarray, support: tuple[Hold, ...],
         _add_hold_task(solver, hold, "soft", config.moving_position_weight,
                        config.moving_orientation_weight, preferences)
     if posture_rad:
-        names = {n for n in robot.joint_names()}
         jt = solver.add_joints_task()
-        jt.set_joints({k: v for k, v in posture_rad.items() if k in names})
+        jt.set_joints({k: v for k, v in posture_rad.items() if k in kin.q_index})
         jt.configure("posture", "soft", config.posture_weight)
     if torso_R is not None:
         # Torso and pelvis both face the ladder: otherwise waist and hip yaws trade off
