@@ -70,6 +70,38 @@ def test_a_hand_target_at_the_hand_s_own_pose_is_solved(planner, standing):
 
 
 
+def test_ik_hold_errors_are_the_distance_and_the_turn_from_the_hold(planner, standing):
+    """The IK's per-iteration hold check (scalar arithmetic) against its definition: the
+    frame's distance from the target, and its turn from it: a hand's grip axis only, a
+    foot's whole orientation (the angle of R_frameᵀ R_target)."""
+    from scipy.spatial.transform import Rotation
+
+    from planner.configuration.ik import _hold_checks, _hold_error
+
+    q, stance = standing
+    kin = planner.kin
+    kin.set_q(q)
+    rng = np.random.default_rng(7)
+    for limb in ("left_hand", "right_foot"):
+        T_now = kin.frame_pose(q, Hold(limb, "x", np.eye(4), np.zeros((1, 3)),
+                                       np.zeros((1, 3))).frame)
+        for _ in range(5):
+            T = np.eye(4)
+            T[:3, :3] = Rotation.from_rotvec(rng.normal(0, 0.3, 3)).as_matrix() @ T_now[:3, :3]
+            T[:3, 3] = T_now[:3, 3] + rng.normal(0, 0.05, 3)
+            hold = Hold(limb, "x", T, np.zeros((1, 3)), np.zeros((1, 3)))
+            (check,) = _hold_checks((hold,), (), IKConfig())
+            dp, da = _hold_error(kin, check)
+            assert dp == pytest.approx(np.linalg.norm(T_now[:3, 3] - T[:3, 3]), abs=1e-12)
+            if hold.is_hand:
+                turn = np.arccos(np.clip(T_now[:3, 0] @ T[:3, 0], -1, 1))
+            else:
+                turn = Rotation.from_matrix(T_now[:3, :3].T @ T[:3, :3]).magnitude()
+            assert da == pytest.approx(turn, abs=1e-7)
+    with pytest.raises(ValueError):
+        Hold("left_elbow", "x", np.eye(4), np.zeros((1, 3)), np.zeros((1, 3)))
+
+
 def test_a_hard_hold_beyond_one_bounded_step_widens_the_step(planner, standing):
     """The midpoint of a long move (a lift-off far from the stance it leaves) can be
     centimetres off its holds; one speed-bounded step cannot meet a hard hold that far
