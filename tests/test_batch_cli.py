@@ -149,12 +149,16 @@ def test_motion_settings_repeat_each_closed_run_on_the_same_draws(tmp_path):
     """``--motion`` makes one closed run per setting value, each in its own row, on the
     draws that the other values and the open run see; the settings reach the job and its
     fingerprint, and crossing two flags makes every combination."""
-    labels, runs = _both_loops(tmp_path / "o", "--perturb", "placement=0.03",
-                               "--motion", "grip_bending_onset=0,0.35",
-                               "--motion", "gravity_compensation=off")
-    assert labels == ["mixed closed, grip_bending_onset=0, gravity_compensation=off",
-                      "mixed closed, grip_bending_onset=0.35, gravity_compensation=off",
+    flags = ("--perturb", "placement=0.03", "--motion", "grip_bending_onset=0,0.35",
+             "--motion", "gravity_compensation=off")
+    labels, runs = _both_loops(tmp_path / "o", *flags)
+    assert labels == ["mixed closed, gravity_compensation=off, grip_bending_onset=0",
+                      "mixed closed, gravity_compensation=off, grip_bending_onset=0.35",
                       "mixed open"]
+    # resumed, the rows count the records read back from the results file
+    _both_loops(tmp_path / "o", *flags)
+    rows = list(csv.DictReader((tmp_path / "o" / "summary.csv").open()))
+    assert [(r["runs"], r["missing"]) for r in rows] == [("2", "0")] * 3
     seed1 = sorted((r for r in runs if r["seed"] == 1), key=lambda r: r["key"])
     assert [(r["loop"], r.get("motion")) for r in seed1] == [
         ("closed", {"grip_bending_onset": 0.0, "gravity_compensation": False}),

@@ -176,7 +176,7 @@ def run_label(strategy: str, loop: str, replan_beyond_m: float = 0.0,
     label = f"{strategy} {loop}"
     if loop == "closed" and replan_beyond_m > 0:
         label += f", re-plan > {replan_beyond_m * 100:g} cm"
-    for name, value in (motion or {}).items():
+    for name, value in sorted((motion or {}).items()):  # as a resumed record reads them
         label += f", {name}={_setting_text(value)}"
     return label
 
