@@ -38,7 +38,7 @@ def small_plan(job: PlanJob, out_dir: str) -> dict:
     if margin < 0.0:
         return {"outcome": "no_plan", "cause": "no_plan", "plan_s": 0.0,
                 "where": "climbRung at rung 1",
-                "why": f"climbRung at rung 1: margin {margin:.3f} m < 0"}
+                "why": f"no plan: climbRung at rung 1: margin {margin:.3f} m < 0"}
     name = f"plans/{job.ladder_key}-s{job.seed}.json"
     path = Path(out_dir) / name
     path.parent.mkdir(parents=True, exist_ok=True)

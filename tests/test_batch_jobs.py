@@ -273,7 +273,7 @@ def test_no_plan_makes_failed_trials_without_simulating(tmp_path, engine):
     for r in run.records:
         if r["kind"] == "validate" and r["seed"] in no_plan:
             assert (r["outcome"], r["cause"]) == ("failed", "no_plan")
-            assert r["why"].startswith("no plan: climbRung at rung 1")
+            assert r["why"].startswith("no plan: climbRung at rung 1")  # the plan's, once
     assert math.isfinite(run.wall_s)
 
 

@@ -11,9 +11,10 @@ files, which the plan job writes under ``OUT/plans/`` (with a remote Dask cluste
 A job function returns a JSON-able dict, the job's *outcome*:
 
 - plan: ``outcome`` ``planned`` (``traj``, ``plan_s``, ``motion_s``, ``top_rung``) or
-  ``no_plan`` (``cause`` ``no_plan``; ``why``: plan-ladder's message, the deepest step
-  reached and its reasons in user terms, or the timing error; ``search_reason``: the
-  search's own text, with the solver's figures);
+  ``no_plan`` (``cause`` ``no_plan``; ``why``: plan-ladder's ``no plan: ...`` message,
+  the reach pre-check's refusal or the deepest step reached and its reasons in user
+  terms, or the timing error; its validate jobs carry the same ``why``;
+  ``search_reason``: the search's own text, with the solver's figures);
 - validate: ``outcome`` ``climbed`` or ``failed`` with ``cause`` and ``why`` from
   `execute.validate.verdict`, the simulated time and the metrics of
   `execute.validate.metrics`; the whole `execute.validate.cli.result_json` record is kept
@@ -260,7 +261,7 @@ def plan_job(job: PlanJob, out_dir: str) -> dict:
                                seed=job.seed)
     except LadderOutOfReach as exc:
         return {**_NO_PLAN, "plan_s": time.perf_counter() - t0, "top_rung": job.top_rung,
-                "where": "reach", "why": str(exc)}
+                "where": "reach", "why": f"no plan: {exc}"}
     top = planner.top_rung() if job.top_rung is None else job.top_rung
     try:
         with hard_time_limit(job.time_limit_s + HARD_LIMIT_GRACE_S):
@@ -282,7 +283,7 @@ def plan_job(job: PlanJob, out_dir: str) -> dict:
                              {"search_s": result.total_s, "setup_s": search_s - result.total_s})
     except TimingError as exc:
         return {**_NO_PLAN, "plan_s": time.perf_counter() - t0,
-                "top_rung": top, "where": "timing", "why": f"timing: {exc}"}
+                "top_rung": top, "where": "timing", "why": f"no plan: timing: {exc}"}
     return {"outcome": "planned", "traj": job.traj_name, "plan_s": time.perf_counter() - t0,
             "search_s": result.total_s, "motion_s": written.timed.duration_s,
             "lines": written.sidecar.line_count, "top_rung": top}

@@ -198,7 +198,7 @@ class _Scheduler:
                 self.ready.appendleft(v)
             elif prec.get("status") == "ok":
                 self.record(v, "ok", {"outcome": "failed", "cause": FailureCause.NO_PLAN.value,
-                                      "why": f"no plan: {prec.get('why', '')}",
+                                      "why": prec.get("why", "no plan"),
                                       "simulated_s": 0.0, "simulated_s_per_rung": None})
             else:
                 self.record(v, "error", {"error": f"its plan job {plan_key} failed: "
