@@ -173,6 +173,11 @@ def parse_args(argv: list[str] | None = None) -> dict:
             "verbose": a.verbose}
 
 
+#: The motion-layer settings ``--motion`` varies: all but ``replan_beyond_m``, whose own
+#: flag also plans again.
+_MOTION_FLAG_SETTINGS = tuple(s for s in SETTINGS if s != "replan_beyond_m")
+
+
 def _motion_variants(flags: list[str]) -> list[tuple[tuple[str, object], ...]]:
     """Every combination of the ``--motion SETTING=V1,V2`` flags' values, in flag order
     (one empty variant when none is given)."""
@@ -183,7 +188,7 @@ def _motion_variants(flags: list[str]) -> list[tuple[tuple[str, object], ...]]:
         name = name.strip()
         if not eq or not values.strip():
             raise InputError(f"option --motion {flag!r}: give SETTING=V1,V2 (settings: "
-                             f"{', '.join(s for s in SETTINGS if s != 'replan_beyond_m')})")
+                             f"{', '.join(_MOTION_FLAG_SETTINGS)})")
         if name == "replan_beyond_m":
             raise InputError("option --motion replan_beyond_m: use --replan-beyond, which "
                              "also plans again")

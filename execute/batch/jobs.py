@@ -118,7 +118,7 @@ class ValidateJob:
             a hold further than this from the plan's [m] (`MotionConfig.replan_beyond_m`;
             0 never).
         motion: closed loop: (field, value) settings of the motion layer that this run
-            sets (`batch-eval --motion`); the others keep their defaults.
+            sets (`batch-eval --motion`), in name order; the others keep their defaults.
     """
 
     plan: PlanJob
@@ -177,7 +177,7 @@ def run_label(strategy: str, loop: str, replan_beyond_m: float = 0.0,
     label = f"{strategy} {loop}"
     if loop == "closed" and replan_beyond_m > 0:
         label += f", re-plan > {replan_beyond_m * 100:g} cm"
-    for name, value in sorted((motion or {}).items()):  # as a resumed record reads them
+    for name, value in (motion or {}).items():
         label += f", {name}={_setting_text(value)}"
     return label
 
@@ -215,7 +215,9 @@ def expand_jobs(ladders: Sequence[tuple[str, LadderSpec, dict[str, Any]]], seeds
         replan_beyond_m: closed runs plan again beyond this first-touch error [m] (0 never).
         motion_variants: the closed runs' motion-layer settings (`ValidateJob.motion`):
             every closed run is made once per variant, each on the same draws; an open
-            run, which has no motion layer, once.
+            run, which has no motion layer, once. A variant's settings are kept in name
+            order, the order a resumed batch reads them back in from its results file
+            (written with sorted keys), so that its key, row and records agree.
 
     Returns:
         (plan jobs, validate jobs), in ladder, seed, strategy, loop, variant, draw order.
@@ -232,7 +234,7 @@ def expand_jobs(ladders: Sequence[tuple[str, LadderSpec, dict[str, Any]]], seeds
                         for i in range(draws):
                             validations.append(ValidateJob(
                                 p, strategy, i, draw(perturb, key, int(seed), strategy, i),
-                                loop, replan_beyond_m, tuple(motion)))
+                                loop, replan_beyond_m, tuple(sorted(motion))))
     return plans, validations
 
 

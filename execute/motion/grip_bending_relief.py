@@ -44,7 +44,7 @@ import numpy as np
 
 from execute.motion.leg_relief import project_off_cone
 from execute.motion.robot_model import MotionRobotModel
-from robot.joints import JOINT_INDEX, LEG_JOINTS
+from robot.joints import LEG_JOINTS, joint_indices
 from robot.limits import joint_limits
 
 __all__ = ["GripBendingRelief"]
@@ -82,12 +82,12 @@ class GripBendingRelief:
             raise ValueError("need 0 < release_share < onset_share < 1")
         self.leg_guard = leg_guard_share
         self.limit_nm = joint_limits(robot).torque_max_nm
-        self._leg_cols = {side: np.array([JOINT_INDEX[n] for n in LEG_JOINTS[side]])
+        self._leg_cols = {side: np.array(joint_indices(LEG_JOINTS[side]))
                           for side in LEG_JOINTS}
         #: the shoulder and elbow joints of each arm: the term's feed-forward acts on
         #: them alone (module docstring)
-        self._proximal_cols = {side: [JOINT_INDEX[side[0].upper() + j]
-                                      for j in _SHOULDER_AND_ELBOW]
+        self._proximal_cols = {side: joint_indices([side[0].upper() + j
+                                                    for j in _SHOULDER_AND_ELBOW])
                                for side in ("left", "right")}
         self.model = model
         self.capacity_nm = bending_capacity_nm

@@ -81,6 +81,9 @@ class MotionRobotModel:
         self._jac_at: bytes | None = None  # `_memo_key` of the configuration in it
         #: (`_memo_key`, torques) of the last two `gravity_torques` configurations
         self._gravity_memo: list[tuple[bytes, np.ndarray]] = []
+        #: hand → (its configuration's and arm torques' bytes, the last `hand_wrench`):
+        #: the leg relief's grip bound and the bending relief read it in the same tick
+        self._wrench_memo: dict[str, tuple[bytes, np.ndarray]] = {}
 
     # ------------------------------------------------------------------ conversions
     def configuration(self, q_cols_rad: np.ndarray, T_world_pelvis: np.ndarray | None = None
@@ -174,11 +177,18 @@ class MotionRobotModel:
         climb's slow moves.
         """
         cols = np.asarray(self.chains[hand].columns)
+        key = _memo_key(q_cols_rad, R_world_pelvis) + np.asarray(
+            torque_nm, dtype=float)[cols].tobytes()
+        known = self._wrench_memo.get(hand)
+        if known is not None and known[0] == key:
+            return known[1].copy()
         d = self._kinematics_at(q_cols_rad, R_world_pelvis)
         J = pin.getFrameJacobian(self.model, d, self._frame_id[self.chains[hand].frame],
                                  pin.LOCAL_WORLD_ALIGNED)[:, self._v_of_col[cols]]
         held = self.gravity_torques(q_cols_rad, R_world_pelvis)[cols] - torque_nm[cols]
-        return np.linalg.lstsq(J.T, held, rcond=None)[0]
+        wrench = np.linalg.lstsq(J.T, held, rcond=None)[0]
+        self._wrench_memo[hand] = (key, wrench)
+        return wrench.copy()
 
     def _sole_columns(self, q_cols_rad: np.ndarray, R_world_pelvis: np.ndarray,
                       joint_cols: int | np.ndarray, foot: str):
