@@ -125,6 +125,9 @@ def _reason_text(key: tuple, best: SampleFailure, moving: set[str]) -> str:
         return f"{stage}: the holds cannot carry the robot's weight"
     if kind == str(RejectCause.JOINT_LIMITS):
         return f"{stage}: a joint would pass its limit"
+    if kind == str(RejectCause.WRIST_SINGULARITY):
+        return (f"{stage}: a hand on its hold would need its wrist straight (pitch near "
+                f"zero), where the arm cannot turn it and the grip takes the load")
     if not math.isnan(best.joint_move_rad):
         return (f"{stage}: meeting the holds exactly would turn a joint by at best "
                 f"{math.degrees(best.joint_move_rad):.0f}°")

@@ -13,6 +13,7 @@ close hands).
 from __future__ import annotations
 
 import logging
+import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -26,7 +27,12 @@ from planner.configuration.collision import CollisionModel
 from planner.configuration.feasible import FeasibleSearchStats, SearchTarget, find_feasible
 from planner.configuration.ik import IKConfig, solve_ik
 from planner.configuration.kinematics import HuboKinematics
-from planner.configuration.validity import FeasibilityChecker, Verdict
+from planner.configuration.validity import (
+    HELD_WRIST_MARGIN_RAD,
+    WRIST_PITCH_JOINT,
+    FeasibilityChecker,
+    Verdict,
+)
 from planner.contacts import Hold, Stance
 from planner.failure_report import SampleFailure, explain_no_plan
 from planner.holds import FOOT_COP_MARGIN_M, FOOT_FRICTION_SHARE, GRIP_STYLES, make_hold
@@ -77,6 +83,11 @@ START_POSTURES = (
     {"HP": -0.2, "KN": 0.4, "AP": -0.2, "SP": -0.5, "SR": 0.3, "EB": -1.2},
     {"HP": -0.2, "KN": 0.4, "AP": -0.2, "SP": 0.0, "SR": 0.15, "EB": -0.3},
 )
+
+
+#: How much further from zero than the checker's band the IK bounds a held wrist's pitch
+#: [rad] (`ClimbPlanner._wrist_bounds`).
+WRIST_BOUND_SLACK_RAD = 0.05
 
 
 @dataclass(frozen=True)
@@ -132,6 +143,10 @@ class PlannerConfig:
     limb_rrt_max_checks: int = 30000
     limb_rrt_tries_per_step: int = 4
     limb_rrt_after_failures: int = 40
+    # A hand on a rail keeps its wrist pitch at least this far from zero [rad], where the
+    # wrist's yaw and roll axes line up and the grip, not the arm, takes any turn across
+    # the rail (docs/decisions/held-wrist-singularity.md). 0: no bound.
+    held_wrist_margin_rad: float = HELD_WRIST_MARGIN_RAD
 
     def torque_share(self, failed_samples: int) -> float:
         """The share of their torque limits position-mode joints are planned to in a
@@ -298,7 +313,8 @@ class ClimbPlanner:
                 f"{side}WP", *closed_hand_wrist_pitch_range_rad(self.kin, self.collision, side))
         self.checker = FeasibilityChecker(self.kin, self.collision, config.min_margin_m,
                                           config.arm_strategy, config.max_torque_ratio,
-                                          config.position_torque_share)
+                                          config.position_torque_share,
+                                          config.held_wrist_margin_rad)
         self.config = config
         self.seed = seed
         self.rng = np.random.default_rng(seed)
@@ -440,26 +456,53 @@ class ClimbPlanner:
             target[2] = self._standing_pelvis_z_m - step.primitive.pelvis_below_standing_m
         return target
 
-    def _posture(self, step: Step, q: np.ndarray, support) -> dict[str, float]:
+    def _posture(self, step: Step, q: np.ndarray, support, contacts) -> dict[str, float]:
         """Seed posture: the primitive's, except that an arm holding a rail prefers where
         it is. A 7-joint arm on a fixed hand can fold two ways; jumping between them has
-        no continuous path on the hold."""
+        no continuous path on the hold. A hand on its hold (held or arriving, in
+        ``contacts``) prefers its wrist pitch out of the checker's band about zero, on the
+        side it is on: the primitive's straight wrist is where that band is."""
         posture = dict(step.primitive.posture_rad)
         for h in support:
             if h.is_hand:
                 for name in ARM_JOINTS[Limb(h.limb).side]:
                     if name in self.kin.q_index:
                         posture[name] = float(q[self.kin.q_index[name]])
+        margin_rad = self.config.held_wrist_margin_rad
+        for limb, joint in WRIST_PITCH_JOINT.items():
+            pitch_rad = float(q[self.kin.q_index[joint]])
+            if margin_rad > 0 and limb in contacts and abs(pitch_rad) < 2 * margin_rad:
+                posture[joint] = math.copysign(2 * margin_rad, pitch_rad)
         return posture
+
+    def _wrist_bounds(self, q: np.ndarray, contacts) -> dict[str, tuple[float, float]]:
+        """A hand on its hold keeps its wrist pitch on the side of zero it is on, at least
+        the checker's margin from it: the IK's bound, so that no sample flips the wrist
+        through its singularity."""
+        margin_rad = self.config.held_wrist_margin_rad
+        if margin_rad <= 0:
+            return {}
+        # the IK's bound stands WRIST_BOUND_SLACK_RAD further out than the checker's, so
+        # that the interpolated poses between two solutions stay out of its band
+        bound_rad = margin_rad + WRIST_BOUND_SLACK_RAD
+        bounds = {}
+        for limb, joint in WRIST_PITCH_JOINT.items():
+            if limb in contacts:
+                bounds[joint] = ((bound_rad, np.inf) if q[self.kin.q_index[joint]] >= 0
+                                 else (-np.inf, -bound_rad))
+        return bounds
 
     def _target(self, step: Step, support, moving, stability: Stance, contacts,
                 pelvis=None, weight=PELVIS_WEIGHT, q=None) -> SearchTarget:
-        posture = step.primitive.posture_rad if q is None else self._posture(step, q, support)
+        posture = (step.primitive.posture_rad if q is None
+                   else self._posture(step, q, support, contacts))
         return SearchTarget(support=tuple(support), moving=tuple(moving),
                             stability_stance=stability, contacts=contacts,
                             posture_rad=posture, pelvis_target_m=pelvis,
                             pelvis_weight=weight, torso_R=self.torso_R,
-                            retreat_direction=self.away)
+                            retreat_direction=self.away,
+                            joint_bounds_rad=None if q is None else
+                            self._wrist_bounds(q, contacts))
 
     def _hint(self, step: Step, stage: int, attempt: int) -> np.ndarray | None:
         """The configuration found for ``step``'s primitive at ``stage`` on an earlier rung,

@@ -181,6 +181,7 @@ class RejectCause(StrEnum):
     COM_OUTSIDE = "CoM"
     TORQUE = "torque"
     IK = "ik"
+    WRIST_SINGULARITY = "wrist"
 
 
 class InterpolationFailure(StrEnum):

@@ -39,6 +39,8 @@ class SearchTarget:
         pelvis_target_m: preferred pelvis position [m] or None.
         pelvis_weight: weight of the pelvis preference.
         torso_R: preferred torso orientation.
+        joint_bounds_rad: joint → (lower, upper) [rad] the IK keeps it within, inside its
+            limits (a held wrist's pitch on its side of the singularity).
     """
 
     support: tuple[Hold, ...]
@@ -50,6 +52,7 @@ class SearchTarget:
     pelvis_weight: float
     torso_R: np.ndarray
     retreat_direction: np.ndarray  # unit vector away from the ladder, for retraction
+    joint_bounds_rad: dict[str, tuple[float, float]] | None = None  # narrower limits
 
 
 @dataclass
@@ -122,7 +125,8 @@ def _descend_torque(kin: HuboKinematics, checker: FeasibilityChecker, target: Se
                           torso_R=target.torso_R @ _turn(cand_turn),
                           pelvis_target_m=cand_pelvis,
                           pelvis_weight=max(target.pelvis_weight, 1.0), com_polygon_cw=polygon,
-                          preferences=False, config=ik_config)
+                          preferences=False, joint_bounds_rad=target.joint_bounds_rad,
+                          config=ik_config)
         stats.attempts += 1
         stale += 1
         if not result.converged:
@@ -166,7 +170,7 @@ def find_feasible(kin: HuboKinematics, checker: FeasibilityChecker, q_seed: np.n
         result = solve_ik(kin, q_hint, target.support, target.moving,
                           posture_rad=kin.posture(q_hint), pelvis_target_m=q_hint[:3].copy(),
                           pelvis_weight=1.0, com_polygon_cw=polygon, preferences=False,
-                          config=ik_config)
+                          joint_bounds_rad=target.joint_bounds_rad, config=ik_config)
         if result.converged:
             verdict = checker.check(result.q, target.stability_stance, target.contacts)
             if verdict.ok:
@@ -184,7 +188,7 @@ def find_feasible(kin: HuboKinematics, checker: FeasibilityChecker, q_seed: np.n
             result = solve_ik(kin, q_try, target.support, target.moving, posture_rad=posture,
                               torso_R=target.torso_R, pelvis_target_m=pelvis,
                               pelvis_weight=target.pelvis_weight, com_polygon_cw=polygon,
-                              config=ik_config)
+                              joint_bounds_rad=target.joint_bounds_rad, config=ik_config)
             if not result.converged:
                 stats.ik_failures += 1
                 last = Verdict.ik_failure(result)

@@ -152,7 +152,8 @@ def solve_ik(kin: HuboKinematics, q_seed: np.ndarray, support: tuple[Hold, ...],
              moving: tuple[Hold, ...] = (), *, posture_rad: dict[str, float] | None = None,
              torso_R: np.ndarray | None = None, pelvis_target_m: np.ndarray | None = None,
              pelvis_weight: float = 0.0, com_polygon_cw: np.ndarray | None = None,
-             preferences: bool = True, config: IKConfig = IKConfig()) -> IKResult:
+             preferences: bool = True, joint_bounds_rad: dict[str, tuple[float, float]] | None
+             = None, config: IKConfig = IKConfig()) -> IKResult:
     """Project ``q_seed`` onto the holds and pull the moving limbs to their targets.
 
     Args:
@@ -166,10 +167,33 @@ def solve_ik(kin: HuboKinematics, q_seed: np.ndarray, support: tuple[Hold, ...],
         com_polygon_cw: clockwise CoM polygon (k, 2) to stay inside, with margin.
         preferences: add soft preferences of the holds (hand open side towards the
             ladder). Off for projections, where only the posture task may pull.
+        joint_bounds_rad: joint → (lower, upper) [rad], narrowing its limits for this
+            solve only (hard, as the limits are).
 
     Returns:
         The result; ``converged`` means every hold and target is met within tolerance.
     """
+    robot = kin.wrapper
+    if not joint_bounds_rad:
+        return _solve(kin, q_seed, support, moving, posture_rad, torso_R, pelvis_target_m,
+                      pelvis_weight, com_polygon_cw, preferences, config)
+    limits = robot.model.lowerPositionLimit, robot.model.upperPositionLimit
+    saved = {name: (float(limits[0][kin.q_index[name]]), float(limits[1][kin.q_index[name]]))
+             for name in joint_bounds_rad}
+    try:
+        for name, (lo, hi) in joint_bounds_rad.items():
+            robot.set_joint_limits(name, max(lo, saved[name][0]), min(hi, saved[name][1]))
+        return _solve(kin, q_seed, support, moving, posture_rad, torso_R, pelvis_target_m,
+                      pelvis_weight, com_polygon_cw, preferences, config)
+    finally:
+        for name, (lo, hi) in saved.items():
+            robot.set_joint_limits(name, lo, hi)
+
+
+def _solve(kin: HuboKinematics, q_seed: np.ndarray, support: tuple[Hold, ...],
+           moving: tuple[Hold, ...], posture_rad, torso_R, pelvis_target_m, pelvis_weight,
+           com_polygon_cw, preferences: bool, config: IKConfig) -> IKResult:
+    """`solve_ik` within the robot's current joint limits."""
     robot = kin.wrapper
     kin.set_q(q_seed)
     solver = robot.make_solver()

@@ -31,6 +31,17 @@ from robot.vocabulary import RejectCause
 #: Tolerance on the joint limits [rad] (placo's QP meets them to solver precision).
 LIMIT_TOL_RAD = 1e-6
 
+#: How far from zero a hand's wrist pitch stays while the hand is on its hold [rad]. At
+#: zero pitch the wrist's yaw and roll axes line up: the arm cannot turn the palm about
+#: the third direction, and whatever the body's motion asks of that turn (a ladder not
+#: quite where the plan has it, a compliant arm lagging its reference) reaches the grip
+#: as bending. Plans that turned a held wrist through zero lost their grips there under
+#: misplacement at 0.01–0.13 rad of pitch (docs/decisions/held-wrist-singularity.md).
+HELD_WRIST_MARGIN_RAD = 0.15
+
+#: Hand → its wrist pitch joint.
+WRIST_PITCH_JOINT = {"left_hand": "LWP", "right_hand": "RWP"}
+
 
 @dataclass(frozen=True)
 class Verdict:
@@ -62,8 +73,12 @@ class FeasibilityChecker:
 
     def __init__(self, kin: HuboKinematics, collision: CollisionModel,
                  min_margin_m: float = 0.0, arm_strategy: str = DEFAULT_ARM_STRATEGY,
-                 max_torque_ratio: float = 1.0, position_torque_share: float = 1.0):
+                 max_torque_ratio: float = 1.0, position_torque_share: float = 1.0,
+                 held_wrist_margin_rad: float = 0.0):
         self.kin = kin
+        self.held_wrist_margin_rad = held_wrist_margin_rad
+        self.wrist_pitch_index = {limb: kin.q_index[joint]
+                                  for limb, joint in WRIST_PITCH_JOINT.items()}
         self.collision = collision
         self.min_margin_m = min_margin_m
         self.max_torque_ratio = max_torque_ratio
@@ -116,6 +131,10 @@ class FeasibilityChecker:
         if not self.within_limits(q):
             return Verdict(False, "joint limits", np.nan, np.nan,
                            cause=RejectCause.JOINT_LIMITS)
+        if (limb := self.singular_held_wrist(q, contacts)) is not None:
+            return Verdict(False, f"{limb}'s wrist pitch within "
+                                  f"{self.held_wrist_margin_rad:.2f} rad of its singularity",
+                           np.nan, np.nan, cause=RejectCause.WRIST_SINGULARITY)
         self.collision.allow(contacts)
         if self.collision.in_collision(q):
             pairs = self.collision.colliding_pairs(q)
@@ -142,6 +161,14 @@ class FeasibilityChecker:
             return Verdict(False, why, report.margin_m, ratio, cause=cause,
                            torque_joint=report.torque.worst_joint if report.torque else "")
         return Verdict(True, "ok", report.margin_m, ratio)
+
+    def singular_held_wrist(self, q: np.ndarray, contacts: dict[str, str]) -> str | None:
+        """The first hand on its hold (in ``contacts``) whose wrist pitch is within
+        ``held_wrist_margin_rad`` of zero, or None."""
+        for limb, index in self.wrist_pitch_index.items():
+            if limb in contacts and abs(float(q[index])) < self.held_wrist_margin_rad:
+                return limb
+        return None
 
     def within_limits(self, q: np.ndarray) -> bool:
         joints = q[7:]
