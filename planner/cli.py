@@ -29,7 +29,7 @@ import sys
 import time
 from pathlib import Path
 
-from planner.holds import FOOT_COP_MARGIN_M, FOOT_FRICTION_SHARE
+from planner.holds import FOOT_COP_MARGIN_M, FOOT_FRICTION_SHARE, HELD_WRIST_MARGIN_RAD
 from planner.statics.arm_capacity import DEFAULT_POSITION_TORQUE_SHARE
 from robot.constants import DAEMON_RATE_HZ
 from robot.errors import InputError, run_cli
@@ -84,6 +84,10 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--foot-friction-share", type=float, default=FOOT_FRICTION_SHARE,
                    metavar="S", help="share of the ladder's friction coefficient a foot is "
                                      "planned to use (default %(default)g)")
+    p.add_argument("--held-wrist-margin", type=float, default=HELD_WRIST_MARGIN_RAD,
+                   metavar="RAD", help="how far from zero a hand on its hold keeps its wrist "
+                                       "pitch, the wrist's singularity [rad] (default "
+                                       "%(default)g; 0: no bound)")
     p.add_argument("--dwell", type=float, default=0.5, metavar="S",
                    help="quasi-static hold after each step [s] (default 0.5)")
     p.add_argument("--plots", metavar="DIR", help="write the CoM/support-region plot of "
@@ -113,7 +117,9 @@ def _check_args(args: argparse.Namespace) -> None:
             ("--foot-cop-margin", args.foot_cop_margin, 0 <= args.foot_cop_margin <= 0.04,
              "in [0, 0.04] m"),
             ("--foot-friction-share", args.foot_friction_share,
-             0 < args.foot_friction_share <= 1, "in (0, 1]")):
+             0 < args.foot_friction_share <= 1, "in (0, 1]"),
+            ("--held-wrist-margin", args.held_wrist_margin, 0 <= args.held_wrist_margin <= 0.5,
+             "in [0, 0.5] rad")):
         if not ok:
             raise InputError(f"option {name} is {value:g}; it must be {rule}")
 
@@ -180,7 +186,8 @@ def _plan(args: argparse.Namespace, err) -> int:
                            reserve_torque_share=args.reserve_torque_share,
                            reserve_samples=args.reserve_samples,
                            foot_cop_margin_m=args.foot_cop_margin,
-                           foot_friction_share=args.foot_friction_share)
+                           foot_friction_share=args.foot_friction_share,
+                           held_wrist_margin_rad=args.held_wrist_margin)
     try:
         planner = ClimbPlanner(spec, robot=args.robot, config=config, seed=args.seed)
     except LadderOutOfReach as exc:

@@ -308,6 +308,7 @@ def _arm_metrics(planner: ClimbPlanner, turn: dict[str, np.ndarray]) -> dict:
         "reserve_torque_share": planner.config.torque_share(0),
         "foot_cop_margin_m": planner.config.foot_cop_margin_m,
         "foot_friction_share": planner.config.foot_friction_share,
+        "held_wrist_margin_rad": planner.config.held_wrist_margin_rad,
     }
 
 

@@ -27,15 +27,17 @@ from planner.configuration.collision import CollisionModel
 from planner.configuration.feasible import FeasibleSearchStats, SearchTarget, find_feasible
 from planner.configuration.ik import IKConfig, solve_ik
 from planner.configuration.kinematics import HuboKinematics
-from planner.configuration.validity import (
-    HELD_WRIST_MARGIN_RAD,
-    WRIST_PITCH_JOINT,
-    FeasibilityChecker,
-    Verdict,
-)
+from planner.configuration.validity import FeasibilityChecker, Verdict
 from planner.contacts import Hold, Stance
 from planner.failure_report import SampleFailure, explain_no_plan
-from planner.holds import FOOT_COP_MARGIN_M, FOOT_FRICTION_SHARE, GRIP_STYLES, make_hold
+from planner.holds import (
+    FOOT_COP_MARGIN_M,
+    FOOT_FRICTION_SHARE,
+    GRIP_STYLES,
+    HELD_WRIST_MARGIN_RAD,
+    WRIST_PITCH_JOINT,
+    make_hold,
+)
 from planner.paths.interpolation import (
     InterpolationError,
     InterpolationStats,

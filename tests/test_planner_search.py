@@ -8,9 +8,11 @@ import pytest
 from ladders.loader import load_ladder
 from planner.configuration.ik import IKConfig, solve_ik
 from planner.contacts import Hold, Stance
+from planner.holds import HELD_WRIST_MARGIN_RAD, WRIST_PITCH_JOINT
 from planner.paths.interpolation import InterpolationError, contact_space_interpolate
 from planner.search import ClimbPlanner, PlannerConfig, PlanningFailed, StepStats
 from primitives.library import climb_sequence
+from robot.vocabulary import RejectCause
 
 
 @pytest.fixture(scope="module")
@@ -199,6 +201,44 @@ def test_placed_hands_meet_their_rail_holds(planner, standing):
             axis_point = planner.geom.closest_rail_point(hold.target.split("_")[1], p)
             assert np.linalg.norm(axis_point - p) < 1e-3
     assert [s.phase for s in segs][-2:] == ["grasp", "grasp"]
+
+
+def test_hands_on_their_rails_keep_their_wrists_out_of_the_singular_band(planner, standing):
+    """Held hands' wrist pitches stay at least the margin from zero, where the wrist's yaw
+    and roll axes line up; the checker refuses a held wrist inside the band, and only a
+    held one."""
+    q, stance = standing
+    _, q_end, new_stance = planner.try_step(climb_sequence(0)[0], q, stance, 0.0,
+                                            StepStats("x"))
+    margin = planner.config.held_wrist_margin_rad
+    assert margin == HELD_WRIST_MARGIN_RAD > 0
+    contacts = {h.limb: h.target for h in new_stance.holds}
+    for joint in WRIST_PITCH_JOINT.values():
+        assert abs(q_end[planner.kin.q_index[joint]]) >= margin
+    assert planner.checker.check(q_end, new_stance, contacts).ok
+    straight = q_end.copy()
+    straight[planner.kin.q_index["RWP"]] = 0.5 * margin
+    refused = planner.checker.check(straight, new_stance, contacts)
+    assert refused.cause is RejectCause.WRIST_SINGULARITY and "right_hand" in refused.reason
+    in_air = {k: v for k, v in contacts.items() if k != "right_hand"}
+    assert planner.checker.singular_held_wrist(straight, in_air) is None
+
+
+def test_a_joint_bound_narrows_one_solve_and_the_limits_come_back(planner, standing):
+    q, stance = standing
+    i = planner.kin.q_index["LWP"]
+
+    def limits():
+        model = planner.kin.wrapper.model
+        return float(model.lowerPositionLimit[i]), float(model.upperPositionLimit[i])
+
+    before = limits()
+    r = solve_ik(planner.kin, q, stance.holds, posture_rad={"LWP": 0.0},
+                 joint_bounds_rad={"LWP": (0.3, np.inf)})
+    assert r.converged and r.q[i] >= 0.3 - 1e-6
+    free = solve_ik(planner.kin, q, stance.holds, posture_rad={"LWP": 0.0})
+    assert abs(free.q[i]) < 0.3
+    assert limits() == before
 
 
 def test_unreachable_ladder_fails_with_the_primitive_and_rung():

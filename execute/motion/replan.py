@@ -21,7 +21,8 @@ __all__ = ["ReplanSettings"]
 _PLANNER_FLAGS = {"arm_strategy": "--arm-strategy",
                   "position_torque_share": "--position-torque-share",
                   "foot_cop_margin_m": "--foot-cop-margin",
-                  "foot_friction_share": "--foot-friction-share"}
+                  "foot_friction_share": "--foot-friction-share",
+                  "held_wrist_margin_rad": "--held-wrist-margin"}
 
 
 @dataclass(frozen=True)

@@ -17,6 +17,7 @@ from planner.configuration.collision import CollisionModel
 from planner.configuration.ik import HoldMiss, IKResult
 from planner.configuration.kinematics import HuboKinematics
 from planner.contacts import Stance
+from planner.holds import WRIST_PITCH_JOINT
 from planner.statics.arm_capacity import (
     DEFAULT_ARM_STRATEGY,
     balance_stance,
@@ -30,17 +31,6 @@ from robot.vocabulary import RejectCause
 
 #: Tolerance on the joint limits [rad] (placo's QP meets them to solver precision).
 LIMIT_TOL_RAD = 1e-6
-
-#: How far from zero a hand's wrist pitch stays while the hand is on its hold [rad]. At
-#: zero pitch the wrist's yaw and roll axes line up: the arm cannot turn the palm about
-#: the third direction, and whatever the body's motion asks of that turn (a ladder not
-#: quite where the plan has it, a compliant arm lagging its reference) reaches the grip
-#: as bending. Plans that turned a held wrist through zero lost their grips there under
-#: misplacement at 0.01–0.13 rad of pitch (docs/decisions/held-wrist-singularity.md).
-HELD_WRIST_MARGIN_RAD = 0.15
-
-#: Hand → its wrist pitch joint.
-WRIST_PITCH_JOINT = {"left_hand": "LWP", "right_hand": "RWP"}
 
 
 @dataclass(frozen=True)
