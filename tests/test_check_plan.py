@@ -15,7 +15,12 @@ sys.path.insert(0, str(Path(__file__).parent))
 
 from synthetic_plan import write_synthetic_plan  # noqa: E402
 
-from planner.verify.check import CHECKS, allowed_contacts  # noqa: E402
+from planner.verify.check import (  # noqa: E402
+    CHECKS,
+    CheckResult,
+    allowed_contacts,
+    check_held_wrists,
+)
 from planner.verify.cli import main  # noqa: E402
 from robot.joints import JOINT_INDEX  # noqa: E402
 from robot.limits import joint_limits  # noqa: E402
@@ -53,6 +58,26 @@ def test_moved_hold_fails_naming_the_line(good, tmp_path, capsys):
     line = int(err.split("holds fails at line ")[1].split(":")[0])
     assert line == seg["first_line"]  # every line of it is as far off: the first is named
     assert "right_foot 5.00 cm from its hold on floor" in err
+
+
+def test_a_held_wrist_near_zero_pitch_fails_naming_the_line():
+    """A hand holding a rail keeps its wrist pitch the plan's margin from zero; in the
+    air it may pass zero; a plan made without a margin has nothing to meet."""
+    rail = HoldRecord("rail_right", (0.3, -0.3, 1.0))
+    foot = HoldRecord("floor", (0.0, -0.1, 0.0))
+    segs = [Segment("placeHands", "limb", 0, 1, 10, {"right_foot": foot}, ("right_hand",)),
+            Segment("placeLFoot", "body", 0, 11, 20, {"right_foot": foot, "right_hand": rail})]
+    traj = np.zeros((20, 40))
+    traj[:, JOINT_INDEX["RWP"]] = -0.3
+    traj[4, JOINT_INDEX["RWP"]] = 0.0  # in the air: allowed
+    traj[14, JOINT_INDEX["RWP"]] = -0.1  # held: inside a 0.15 rad margin
+    result = CheckResult("held wrists")
+    check_held_wrists(result, traj, segs, 0.15)
+    assert not result.ok and result.failing_lines == 1 and result.worst_line == 15
+    assert "RWP = -0.1000 rad" in result.detail
+    unbounded = CheckResult("held wrists")
+    check_held_wrists(unbounded, traj, segs, 0.0)
+    assert unbounded.ok and unbounded.value == pytest.approx(0.1)
 
 
 def _knee_past_its_limit(good, path):

@@ -8,6 +8,8 @@ ladder's orientation on a rung, level on the floor), then checks:
 
 - joint limits (the robot's position limits);
 - joint speed between consecutive lines (nominal limits ×1.0 at the file rate);
+- held wrists: a hand holding a rail keeps its wrist pitch the plan's margin from zero,
+  the wrist's singularity (`check_held_wrists`);
 - holds: every limb the sidecar says is in contact has its frame within `HOLD_TOL_M` of
   the recorded hold, and the recorded hold lies within `HOLD_TOL_M` of its rung's tread,
   its rail's axis or the floor;
@@ -50,10 +52,10 @@ from typing import TYPE_CHECKING, NamedTuple
 import numpy as np
 
 from ladders.contact_model import hand_limits, sole_patch_x
-from planner.holds import foot_patch, half_tread_m
+from planner.holds import WRIST_PITCH_JOINT, foot_patch, half_tread_m
 from planner.statics.arm_capacity import balance_stance, gripping_sides, gripping_torque_limits
 from robot.errors import InputError
-from robot.plan_sidecar import PlanSidecar, Segment, segment_of_lines
+from robot.plan_sidecar import PlanSidecar, Segment, hand_holding_lines, segment_of_lines
 from robot.vocabulary import HoldTarget, HoldTargetKind, Limb
 
 if TYPE_CHECKING:
@@ -81,8 +83,8 @@ WORST_TIE = 1e-9
 #: check_plan checks this many lines of a segment at once, and reports its progress after
 #: each batch.
 BATCH_LINES = 1024
-CHECKS = ("joint limits", "velocity", "holds", "collision", "stability margin",
-          "torque ratio", "contact wrench")
+CHECKS = ("joint limits", "velocity", "held wrists", "holds", "collision",
+          "stability margin", "torque ratio", "contact wrench")
 _FRAME = {"left_hand": "L_palm", "right_hand": "R_palm", "left_foot": "L_sole",
           "right_foot": "R_sole"}
 
@@ -509,6 +511,8 @@ def check_plan(traj_rad: np.ndarray, sidecar: PlanSidecar, spec, robot: str | No
     v = PlanVerifier(spec, robot, arm_strategy)
     res = _new_results()
     _check_limits_and_speed(res, traj_rad, joint_limits(robot), rate_hz)
+    check_held_wrists(res["held wrists"], traj_rad, segs,
+                      float(sidecar.metrics.get("held_wrist_margin_rad", 0.0)))
 
     # Per batch of lines of one segment: base from a foot, holds, collisions, stability.
     from planner.verify.line_pass import check_lines
@@ -530,12 +534,41 @@ def _new_results() -> dict[str, CheckResult]:
     res = {c: CheckResult(c) for c in CHECKS}
     res["joint limits"].limit, res["joint limits"].unit = 0.0, "rad past limit"
     res["velocity"].limit, res["velocity"].unit = 1.0, "× nominal"
+    res["held wrists"].unit = "rad from zero"
     res["holds"].limit, res["holds"].unit = HOLD_TOL_M, "m"
     res["collision"].limit, res["collision"].unit = 0.0, "m clearance"
     res["stability margin"].limit, res["stability margin"].unit = 0.0, "m"
     res["torque ratio"].limit, res["torque ratio"].unit = 1.0, "× limit"
     res["contact wrench"].limit, res["contact wrench"].unit = 1.0, "× limit"
     return res
+
+
+def check_held_wrists(result: CheckResult, traj_rad: np.ndarray, segments: Sequence[Segment],
+                      margin_rad: float) -> None:
+    """A hand holding a rail keeps its wrist pitch at least ``margin_rad`` from zero, its
+    singularity (the margin the plan was made with, `planner.holds.HELD_WRIST_MARGIN_RAD`;
+    a plan made without one has nothing to meet). The value is the smallest |pitch| on
+    a holding line."""
+    from robot.joints import JOINT_INDEX
+
+    result.limit = margin_rad
+    worst = None
+    for limb, joint in WRIST_PITCH_JOINT.items():
+        held = hand_holding_lines(segments, len(traj_rad), Limb(limb).side)
+        if not held.any():
+            continue
+        pitch_rad = np.where(held, np.abs(traj_rad[:, JOINT_INDEX[joint]]), np.inf)
+        k = int(np.argmin(pitch_rad))
+        failing = int(np.count_nonzero(pitch_rad < margin_rad - LIMIT_TOL_RAD))
+        if worst is None or pitch_rad[k] < worst[0]:
+            worst = (float(pitch_rad[k]), k, joint)
+        result.failing_lines += failing
+        result.ok &= failing == 0
+    if worst is not None:
+        value, k, joint = worst
+        result.worst_line, result.value = k + 1, value
+        result.detail = (f"{joint} = {traj_rad[k, JOINT_INDEX[joint]]:+.4f} rad while its hand "
+                         f"holds (at least {margin_rad:g} rad from zero)")
 
 
 def _check_limits_and_speed(res: dict[str, CheckResult], traj_rad: np.ndarray, lim,
