@@ -61,19 +61,24 @@ def test_moved_hold_fails_naming_the_line(good, tmp_path, capsys):
 
 
 def test_a_held_wrist_near_zero_pitch_fails_naming_the_line():
-    """A hand holding a rail keeps its wrist pitch the plan's margin from zero; in the
-    air it may pass zero; a plan made without a margin has nothing to meet."""
+    """While a foot is in the air, a hand holding a rail keeps its wrist pitch the plan's
+    margin from zero; a hand in the air, or holding with both feet down, may pass zero; a
+    plan made without a margin has nothing to meet."""
     rail = HoldRecord("rail_right", (0.3, -0.3, 1.0))
-    foot = HoldRecord("floor", (0.0, -0.1, 0.0))
-    segs = [Segment("placeHands", "limb", 0, 1, 10, {"right_foot": foot}, ("right_hand",)),
-            Segment("placeLFoot", "body", 0, 11, 20, {"right_foot": foot, "right_hand": rail})]
-    traj = np.zeros((20, 40))
+    left, right = HoldRecord("floor", (0.0, 0.1, 0.0)), HoldRecord("floor", (0.0, -0.1, 0.0))
+    feet = {"left_foot": left, "right_foot": right}
+    segs = [Segment("placeHands", "limb", 0, 1, 10, feet, ("right_hand",)),
+            Segment("placeLFoot", "body", 0, 11, 20, {**feet, "right_hand": rail}),
+            Segment("placeLFoot", "limb", 0, 21, 30, {"right_foot": right, "right_hand": rail},
+                    ("left_foot",))]
+    traj = np.zeros((30, 40))
     traj[:, JOINT_INDEX["RWP"]] = -0.3
     traj[4, JOINT_INDEX["RWP"]] = 0.0  # in the air: allowed
-    traj[14, JOINT_INDEX["RWP"]] = -0.1  # held: inside a 0.15 rad margin
+    traj[14, JOINT_INDEX["RWP"]] = 0.0  # held, both feet down: allowed
+    traj[24, JOINT_INDEX["RWP"]] = -0.1  # held, a foot in the air: inside a 0.15 rad margin
     result = CheckResult("held wrists")
     check_held_wrists(result, traj, segs, 0.15)
-    assert not result.ok and result.failing_lines == 1 and result.worst_line == 15
+    assert not result.ok and result.failing_lines == 1 and result.worst_line == 25
     assert "RWP = -0.1000 rad" in result.detail
     unbounded = CheckResult("held wrists")
     check_held_wrists(unbounded, traj, segs, 0.0)

@@ -58,6 +58,16 @@ class Verdict:
                    ik_misses=result.misses)
 
 
+def wrist_bound_hands(stance: Stance) -> tuple[str, ...]:
+    """The hands of ``stance`` that keep their wrists out of the singularity: every hand
+    on its hold while a foot is in the air. With both feet down the legs carry the body
+    and a held wrist may pass zero; the plans do, between the foot steps."""
+    holds = [h.limb for h in stance.holds]
+    if sum(1 for limb in holds if limb.endswith("_foot")) >= 2:
+        return ()
+    return tuple(limb for limb in holds if limb in WRIST_PITCH_JOINT)
+
+
 class FeasibilityChecker:
     """Caches the support region per stance and checks configurations against it."""
 
@@ -121,7 +131,7 @@ class FeasibilityChecker:
         if not self.within_limits(q):
             return Verdict(False, "joint limits", np.nan, np.nan,
                            cause=RejectCause.JOINT_LIMITS)
-        if (limb := self.singular_held_wrist(q, contacts)) is not None:
+        if (limb := self.singular_held_wrist(q, stance)) is not None:
             return Verdict(False, f"{limb}'s wrist pitch within "
                                   f"{self.held_wrist_margin_rad:.2f} rad of its singularity",
                            np.nan, np.nan, cause=RejectCause.WRIST_SINGULARITY)
@@ -152,13 +162,13 @@ class FeasibilityChecker:
                            torque_joint=report.torque.worst_joint if report.torque else "")
         return Verdict(True, "ok", report.margin_m, ratio)
 
-    def singular_held_wrist(self, q: np.ndarray, contacts: dict[str, str]) -> str | None:
-        """The first hand on its hold (in ``contacts``) whose wrist pitch is within
-        ``held_wrist_margin_rad`` of zero, or None."""
-        for limb, index in self.wrist_pitch_index.items():
-            if limb in contacts and abs(float(q[index])) < self.held_wrist_margin_rad:
-                return limb
-        return None
+    def singular_held_wrist(self, q: np.ndarray, stance: Stance) -> str | None:
+        """The first hand in ``stance`` whose wrist pitch is within
+        ``held_wrist_margin_rad`` of zero while the stance has fewer than two feet (a
+        foot in the air: the grips carry the body with one leg), or None."""
+        return next((limb for limb in wrist_bound_hands(stance)
+                     if abs(float(q[self.wrist_pitch_index[limb]])) < self.held_wrist_margin_rad),
+                    None)
 
     def within_limits(self, q: np.ndarray) -> bool:
         joints = q[7:]

@@ -8,8 +8,8 @@ ladder's orientation on a rung, level on the floor), then checks:
 
 - joint limits (the robot's position limits);
 - joint speed between consecutive lines (nominal limits ×1.0 at the file rate);
-- held wrists: a hand holding a rail keeps its wrist pitch the plan's margin from zero,
-  the wrist's singularity (`check_held_wrists`);
+- held wrists: while a foot is in the air, a hand holding a rail keeps its wrist pitch
+  the plan's margin from zero, the wrist's singularity (`check_held_wrists`);
 - holds: every limb the sidecar says is in contact has its frame within `HOLD_TOL_M` of
   the recorded hold, and the recorded hold lies within `HOLD_TOL_M` of its rung's tread,
   its rail's axis or the floor;
@@ -55,7 +55,7 @@ from ladders.contact_model import hand_limits, sole_patch_x
 from planner.holds import WRIST_PITCH_JOINT, foot_patch, half_tread_m
 from planner.statics.arm_capacity import balance_stance, gripping_sides, gripping_torque_limits
 from robot.errors import InputError
-from robot.plan_sidecar import PlanSidecar, Segment, hand_holding_lines, segment_of_lines
+from robot.plan_sidecar import PlanSidecar, Segment, segment_of_lines
 from robot.vocabulary import HoldTarget, HoldTargetKind, Limb
 
 if TYPE_CHECKING:
@@ -545,19 +545,25 @@ def _new_results() -> dict[str, CheckResult]:
 
 def check_held_wrists(result: CheckResult, traj_rad: np.ndarray, segments: Sequence[Segment],
                       margin_rad: float) -> None:
-    """A hand holding a rail keeps its wrist pitch at least ``margin_rad`` from zero, its
-    singularity (the margin the plan was made with, `planner.holds.HELD_WRIST_MARGIN_RAD`;
-    a plan made without one has nothing to meet). The value is the smallest |pitch| on
-    a holding line."""
+    """While a foot is in the air, a hand holding a rail keeps its wrist pitch at least
+    ``margin_rad`` from zero, its singularity (the margin the plan was made with,
+    `planner.holds.HELD_WRIST_MARGIN_RAD`, and the planner's rule,
+    `planner.configuration.validity.wrist_bound_hands`; a plan made without a margin has
+    nothing to meet). The value is the smallest |pitch| on such a line."""
     from robot.joints import JOINT_INDEX
 
     result.limit = margin_rad
     worst = None
     for limb, joint in WRIST_PITCH_JOINT.items():
-        held = hand_holding_lines(segments, len(traj_rad), Limb(limb).side)
-        if not held.any():
+        bound = np.zeros(len(traj_rad), dtype=bool)
+        for seg in segments:
+            hold = seg.holds.get(limb)
+            feet = sum(1 for held in seg.holds if held.endswith("_foot"))
+            if hold is not None and hold.hold_target.kind is HoldTargetKind.RAIL and feet < 2:
+                bound[seg.first_line - 1:seg.last_line] = True
+        if not bound.any():
             continue
-        pitch_rad = np.where(held, np.abs(traj_rad[:, JOINT_INDEX[joint]]), np.inf)
+        pitch_rad = np.where(bound, np.abs(traj_rad[:, JOINT_INDEX[joint]]), np.inf)
         k = int(np.argmin(pitch_rad))
         failing = int(np.count_nonzero(pitch_rad < margin_rad - LIMIT_TOL_RAD))
         if worst is None or pitch_rad[k] < worst[0]:
@@ -568,7 +574,8 @@ def check_held_wrists(result: CheckResult, traj_rad: np.ndarray, segments: Seque
         value, k, joint = worst
         result.worst_line, result.value = k + 1, value
         result.detail = (f"{joint} = {traj_rad[k, JOINT_INDEX[joint]]:+.4f} rad while its hand "
-                         f"holds (at least {margin_rad:g} rad from zero)")
+                         f"holds and a foot is in the air (at least {margin_rad:g} rad from "
+                         f"zero)")
 
 
 def _check_limits_and_speed(res: dict[str, CheckResult], traj_rad: np.ndarray, lim,
