@@ -203,25 +203,29 @@ def test_placed_hands_meet_their_rail_holds(planner, standing):
     assert [s.phase for s in segs][-2:] == ["grasp", "grasp"]
 
 
-def test_hands_on_their_rails_keep_their_wrists_out_of_the_singular_band(planner, standing):
-    """Held hands' wrist pitches stay at least the margin from zero, where the wrist's yaw
-    and roll axes line up; the checker refuses a held wrist inside the band, and only a
-    held one."""
+def test_held_wrists_stay_out_of_the_singular_band_while_a_foot_swings(planner, standing):
+    """While a foot is in the air, the hands on the rails keep their wrist pitches at
+    least the margin from zero, where the wrist's yaw and roll axes line up; the checker
+    refuses a held wrist inside the band then, and only then."""
     q, stance = standing
-    _, q_end, new_stance = planner.try_step(climb_sequence(0)[0], q, stance, 0.0,
-                                            StepStats("x"))
+    steps = climb_sequence(0)
+    _, q, stance = planner.try_step(steps[0], q, stance, 0.0, StepStats("x"))
+    segs, q_end, new_stance = planner.try_step(steps[1], q, stance, 0.0, StepStats("x"))
     margin = planner.config.held_wrist_margin_rad
     assert margin == HELD_WRIST_MARGIN_RAD > 0
-    contacts = {h.limb: h.target for h in new_stance.holds}
-    for joint in WRIST_PITCH_JOINT.values():
-        assert abs(q_end[planner.kin.q_index[joint]]) >= margin
-    assert planner.checker.check(q_end, new_stance, contacts).ok
-    straight = q_end.copy()
+    swing = [s for s in segs if s.phase == "limb"]
+    assert swing and all(s.moving_limbs == ("left_foot",) for s in swing)
+    for seg in swing:
+        for c in seg.configs:
+            for joint in WRIST_PITCH_JOINT.values():
+                assert abs(c[planner.kin.q_index[joint]]) >= margin - 1e-9
+    one_foot = Stance(tuple(h for h in new_stance.holds if h.limb != "left_foot"))
+    contacts = {h.limb: h.target for h in one_foot.holds}
+    straight = swing[-1].configs[-1].copy()
     straight[planner.kin.q_index["RWP"]] = 0.5 * margin
-    refused = planner.checker.check(straight, new_stance, contacts)
+    refused = planner.checker.check(straight, one_foot, contacts)
     assert refused.cause is RejectCause.WRIST_SINGULARITY and "right_hand" in refused.reason
-    in_air = {k: v for k, v in contacts.items() if k != "right_hand"}
-    assert planner.checker.singular_held_wrist(straight, in_air) is None
+    assert planner.checker.singular_held_wrist(straight, new_stance) is None  # both feet down
 
 
 def test_a_joint_bound_narrows_one_solve_and_the_limits_come_back(planner, standing):
