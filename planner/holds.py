@@ -136,13 +136,13 @@ FOOT_COP_MARGIN_M = 0.02
 FOOT_FRICTION_SHARE = 0.75
 
 #: How far from zero a hand's wrist pitch stays while the hand holds and a foot is in the
-#: air [rad]. At zero pitch the wrist's yaw and roll axes line up: the arm cannot turn the
-#: palm about the third direction, and whatever the body's motion asks of that turn (a
-#: ladder not quite where the plan has it, a compliant arm lagging its reference) reaches
-#: the grip as bending. Plans that turned a held wrist through zero in a foot's swing lost
-#: their grips there under misplacement, at 0.01–0.13 rad of pitch
-#: (docs/decisions/held-wrist-singularity.md).
-HELD_WRIST_MARGIN_RAD = 0.15
+#: air [rad]; 0: no bound. At zero pitch the wrist's yaw and roll axes line up: the arm
+#: cannot turn the palm about the third direction, and whatever the body's motion asks of
+#: that turn (a ladder not quite where the plan has it, a compliant arm lagging its
+#: reference) reaches the grip as bending. Off by default: at 0.15 rad more DRC mounts
+#: climbed under the harder perturbation, but whole climbs planned less often and climbed
+#: no more often (docs/decisions/held-wrist-singularity.md).
+HELD_WRIST_MARGIN_RAD = 0.0
 
 #: Hand → its wrist pitch joint.
 WRIST_PITCH_JOINT = {"left_hand": "LWP", "right_hand": "RWP"}

@@ -203,16 +203,17 @@ def test_placed_hands_meet_their_rail_holds(planner, standing):
     assert [s.phase for s in segs][-2:] == ["grasp", "grasp"]
 
 
-def test_held_wrists_stay_out_of_the_singular_band_while_a_foot_swings(planner, standing):
-    """While a foot is in the air, the hands on the rails keep their wrist pitches at
-    least the margin from zero, where the wrist's yaw and roll axes line up; the checker
-    refuses a held wrist inside the band then, and only then."""
-    q, stance = standing
+def test_held_wrists_stay_out_of_the_singular_band_while_a_foot_swings():
+    """With a held-wrist margin, while a foot is in the air the hands on the rails keep
+    their wrist pitches at least the margin from zero, where the wrist's yaw and roll
+    axes line up; the checker refuses a held wrist inside the band then, and only then."""
+    margin = 0.15
+    planner = ClimbPlanner(load_ladder("drc"), seed=1,
+                           config=PlannerConfig(held_wrist_margin_rad=margin))
+    q, stance = planner.start_configuration()
     steps = climb_sequence(0)
     _, q, stance = planner.try_step(steps[0], q, stance, 0.0, StepStats("x"))
     segs, q_end, new_stance = planner.try_step(steps[1], q, stance, 0.0, StepStats("x"))
-    margin = planner.config.held_wrist_margin_rad
-    assert margin == HELD_WRIST_MARGIN_RAD > 0
     swing = [s for s in segs if s.phase == "limb"]
     assert swing and all(s.moving_limbs == ("left_foot",) for s in swing)
     for seg in swing:
@@ -226,6 +227,9 @@ def test_held_wrists_stay_out_of_the_singular_band_while_a_foot_swings(planner, 
     refused = planner.checker.check(straight, one_foot, contacts)
     assert refused.cause is RejectCause.WRIST_SINGULARITY and "right_hand" in refused.reason
     assert planner.checker.singular_held_wrist(straight, new_stance) is None  # both feet down
+    assert HELD_WRIST_MARGIN_RAD == 0  # off by default: the default planner has no band
+    assert ClimbPlanner(load_ladder("drc"), seed=1).checker.singular_held_wrist(
+        straight, one_foot) is None
 
 
 def test_a_joint_bound_narrows_one_solve_and_the_limits_come_back(planner, standing):

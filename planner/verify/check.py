@@ -547,7 +547,7 @@ def check_held_wrists(result: CheckResult, traj_rad: np.ndarray, segments: Seque
                       margin_rad: float) -> None:
     """While a foot is in the air, a hand holding a rail keeps its wrist pitch at least
     ``margin_rad`` from zero, its singularity (the margin the plan was made with,
-    `planner.holds.HELD_WRIST_MARGIN_RAD`, and the planner's rule,
+    `plan-ladder --held-wrist-margin`, and the planner's rule,
     `planner.configuration.validity.wrist_bound_hands`; a plan made without a margin has
     nothing to meet). The value is the smallest |pitch| on such a line."""
     from robot.joints import JOINT_INDEX
