@@ -858,13 +858,14 @@ def test_the_new_plan_after_a_misplaced_ladder_is_the_first_plans_settings():
 
     settings = ReplanSettings(seed=4, top_rung=8, rate_hz=200.0,
                               planner={"arm_strategy": "mixed", "position_torque_share": 0.9,
-                                       "foot_cop_margin_m": 0.02, "foot_friction_share": 0.7})
+                                       "foot_cop_margin_m": 0.02, "foot_friction_share": 0.7,
+                                       "held_wrist_margin_rad": 0.15})
     words = shlex.split(settings.command("measured ladder.yaml", "new.traj"))
     assert words[0] == "plan-ladder"
     args = plan_ladder_parser().parse_args(words[1:])
     assert (args.ladder, args.seed, args.top_rung, args.rate, args.out) == (
         "measured ladder.yaml", 4, 8, 200.0, "new.traj")
     assert (args.arm_strategy, args.position_torque_share, args.foot_cop_margin,
-            args.foot_friction_share) == ("mixed", 0.9, 0.02, 0.7)
+            args.foot_friction_share, args.held_wrist_margin) == ("mixed", 0.9, 0.02, 0.7, 0.15)
     floor = ReplanSettings(seed=1, top_rung=None, rate_hz=25.0)
     assert "--top-rung" not in floor.command("l.yaml", "n.traj")

@@ -53,6 +53,8 @@ def test_bad_spec_exits_2_naming_the_field(tmp_path, capsys):
     (["drc", "--foot-cop-margin", "0.05"], "--foot-cop-margin is 0.05; it must be in [0, 0.04]"),
     (["drc", "--foot-friction-share", "1.2"],
      "--foot-friction-share is 1.2; it must be in (0, 1]"),
+    (["drc", "--held-wrist-margin", "0.6"],
+     "--held-wrist-margin is 0.6; it must be in [0, 0.5] rad"),
     (["drc", "--robot", "asimo"], "invalid choice"),
 ])
 def test_bad_options_exit_2(argv, words, capsys):
