@@ -145,9 +145,10 @@ class PlannerConfig:
     limb_rrt_max_checks: int = 30000
     limb_rrt_tries_per_step: int = 4
     limb_rrt_after_failures: int = 40
-    # A hand on a rail keeps its wrist pitch at least this far from zero [rad], where the
-    # wrist's yaw and roll axes line up and the grip, not the arm, takes any turn across
-    # the rail (docs/decisions/held-wrist-singularity.md). 0: no bound.
+    # While a foot is in the air, a hand on its hold keeps its wrist pitch at least this
+    # far from zero [rad], where the wrist's yaw and roll axes line up and the grip, not
+    # the arm, takes any turn across the rail (planner.holds.HELD_WRIST_MARGIN_RAD). 0:
+    # no bound, the default.
     held_wrist_margin_rad: float = HELD_WRIST_MARGIN_RAD
 
     def torque_share(self, failed_samples: int) -> float:
