@@ -83,6 +83,7 @@ def test_a_held_wrist_near_zero_pitch_fails_naming_the_line():
     unbounded = CheckResult("held wrists")
     check_held_wrists(unbounded, traj, segs, 0.0)
     assert unbounded.ok and unbounded.value == pytest.approx(0.1)
+    assert "planned without a margin" in unbounded.detail
 
 
 def _knee_past_its_limit(good, path):

@@ -573,9 +573,10 @@ def check_held_wrists(result: CheckResult, traj_rad: np.ndarray, segments: Seque
     if worst is not None:
         value, k, joint = worst
         result.worst_line, result.value = k + 1, value
+        bound = (f"at least {margin_rad:g} rad from zero" if margin_rad > 0
+                 else "planned without a margin")
         result.detail = (f"{joint} = {traj_rad[k, JOINT_INDEX[joint]]:+.4f} rad while its hand "
-                         f"holds and a foot is in the air (at least {margin_rad:g} rad from "
-                         f"zero)")
+                         f"holds and a foot is in the air ({bound})")
 
 
 def _check_limits_and_speed(res: dict[str, CheckResult], traj_rad: np.ndarray, lim,
