@@ -148,6 +148,18 @@ HELD_WRIST_MARGIN_RAD = 0.0
 WRIST_PITCH_JOINT = {"left_hand": "LWP", "right_hand": "RWP"}
 
 
+def wrist_bound_hands(holding_limbs) -> tuple[str, ...]:
+    """Of the limbs on their holds, the hands that keep their wrists out of the
+    singularity (`HELD_WRIST_MARGIN_RAD`): every hand on its hold while a foot is in the
+    air. With both feet down the legs carry the body and a held wrist may pass zero; the
+    plans do, between the foot steps. The planner's feasibility check and check-plan's
+    `held wrists` both apply this rule."""
+    limbs = list(holding_limbs)
+    if sum(1 for limb in limbs if limb.endswith("_foot")) >= 2:
+        return ()
+    return tuple(limb for limb in limbs if limb in WRIST_PITCH_JOINT)
+
+
 def sole_contact_points(params: RobotParams, T_world_sole: np.ndarray,
                         x_range_m: tuple[float, float], margin_m: float) -> np.ndarray:
     """Four corners of the sole part between ``x_range_m`` (sole frame x), each side

@@ -27,7 +27,7 @@ from planner.configuration.collision import CollisionModel
 from planner.configuration.feasible import FeasibleSearchStats, SearchTarget, find_feasible
 from planner.configuration.ik import IKConfig, solve_ik
 from planner.configuration.kinematics import HuboKinematics
-from planner.configuration.validity import FeasibilityChecker, Verdict, wrist_bound_hands
+from planner.configuration.validity import FeasibilityChecker, Verdict
 from planner.contacts import Hold, Stance
 from planner.failure_report import SampleFailure, explain_no_plan
 from planner.holds import (
@@ -37,6 +37,7 @@ from planner.holds import (
     HELD_WRIST_MARGIN_RAD,
     WRIST_PITCH_JOINT,
     make_hold,
+    wrist_bound_hands,
 )
 from planner.paths.interpolation import (
     InterpolationError,
@@ -459,12 +460,12 @@ class ClimbPlanner:
             target[2] = self._standing_pelvis_z_m - step.primitive.pelvis_below_standing_m
         return target
 
-    def _posture(self, step: Step, q: np.ndarray, support, stability: Stance
-                 ) -> dict[str, float]:
+    def _posture(self, step: Step, q: np.ndarray, support,
+                 wrist_bounds: dict[str, tuple[float, float]]) -> dict[str, float]:
         """Seed posture: the primitive's, except that an arm holding a rail prefers where
         it is. A 7-joint arm on a fixed hand can fold two ways; jumping between them has
-        no continuous path on the hold. A hand whose wrist the checker keeps out of its
-        singularity (`wrist_bound_hands`) prefers its pitch at twice the margin, on the
+        no continuous path on the hold. A wrist the IK bounds away from its singularity
+        (``wrist_bounds``, `_wrist_bounds`) prefers its pitch at twice the margin, on the
         side it is on, when it is nearer zero: the primitive's straight wrist is where
         the band is."""
         posture = dict(step.primitive.posture_rad)
@@ -473,19 +474,17 @@ class ClimbPlanner:
                 for name in ARM_JOINTS[Limb(h.limb).side]:
                     if name in self.kin.q_index:
                         posture[name] = float(q[self.kin.q_index[name]])
-        margin_rad = self.config.held_wrist_margin_rad
-        if margin_rad > 0:
-            for limb in wrist_bound_hands(stability):
-                joint = WRIST_PITCH_JOINT[limb]
-                pitch_rad = float(q[self.kin.q_index[joint]])
-                if abs(pitch_rad) < 2 * margin_rad:
-                    posture[joint] = math.copysign(2 * margin_rad, pitch_rad)
+        preferred_rad = 2 * self.config.held_wrist_margin_rad
+        for joint in wrist_bounds:
+            pitch_rad = float(q[self.kin.q_index[joint]])
+            if abs(pitch_rad) < preferred_rad:
+                posture[joint] = math.copysign(preferred_rad, pitch_rad)
         return posture
 
     def _wrist_bounds(self, q: np.ndarray, stability: Stance) -> dict[str, tuple[float, float]]:
         """The IK's bound on the wrists the checker keeps out of their singularity
-        (`wrist_bound_hands`): each on the side of zero it is on, at least the margin
-        from it, so that no sample flips a wrist through zero."""
+        (`planner.holds.wrist_bound_hands`): each on the side of zero it is on, at least
+        the margin from it, so that no sample flips a wrist through zero."""
         margin_rad = self.config.held_wrist_margin_rad
         if margin_rad <= 0:
             return {}
@@ -493,7 +492,7 @@ class ClimbPlanner:
         # that the interpolated poses between two solutions stay out of its band
         bound_rad = margin_rad + WRIST_BOUND_SLACK_RAD
         bounds = {}
-        for limb in wrist_bound_hands(stability):
+        for limb in wrist_bound_hands(h.limb for h in stability.holds):
             joint = WRIST_PITCH_JOINT[limb]
             bounds[joint] = ((bound_rad, np.inf) if q[self.kin.q_index[joint]] >= 0
                              else (-np.inf, -bound_rad))
@@ -501,15 +500,16 @@ class ClimbPlanner:
 
     def _target(self, step: Step, support, moving, stability: Stance, contacts,
                 pelvis=None, weight=PELVIS_WEIGHT, q=None) -> SearchTarget:
-        posture = (step.primitive.posture_rad if q is None
-                   else self._posture(step, q, support, stability))
+        if q is None:
+            posture, bounds = step.primitive.posture_rad, None
+        else:
+            bounds = self._wrist_bounds(q, stability)
+            posture = self._posture(step, q, support, bounds)
         return SearchTarget(support=tuple(support), moving=tuple(moving),
                             stability_stance=stability, contacts=contacts,
                             posture_rad=posture, pelvis_target_m=pelvis,
                             pelvis_weight=weight, torso_R=self.torso_R,
-                            retreat_direction=self.away,
-                            joint_bounds_rad=None if q is None else
-                            self._wrist_bounds(q, stability))
+                            retreat_direction=self.away, joint_bounds_rad=bounds)
 
     def _hint(self, step: Step, stage: int, attempt: int) -> np.ndarray | None:
         """The configuration found for ``step``'s primitive at ``stage`` on an earlier rung,

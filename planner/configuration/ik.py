@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import logging
 import math
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import NamedTuple
 
@@ -174,79 +175,76 @@ def solve_ik(kin: HuboKinematics, q_seed: np.ndarray, support: tuple[Hold, ...],
         The result; ``converged`` means every hold and target is met within tolerance.
     """
     robot = kin.wrapper
-    if not joint_bounds_rad:
-        return _solve(kin, q_seed, support, moving, posture_rad, torso_R, pelvis_target_m,
-                      pelvis_weight, com_polygon_cw, preferences, config)
-    limits = robot.model.lowerPositionLimit, robot.model.upperPositionLimit
-    saved = {name: (float(limits[0][kin.q_index[name]]), float(limits[1][kin.q_index[name]]))
-             for name in joint_bounds_rad}
+    with _narrowed_limits(kin, joint_bounds_rad or {}):
+        kin.set_q(q_seed)
+        solver = robot.make_solver()
+        solver.mask_fbase(False)
+        solver.enable_joint_limits(True)
+        # Bounding each step by the joints' speed limits × dt keeps the linearised hard tasks
+        # valid; unbounded steps from a far soft target made the QP diverge. The bound is
+        # set per step (`_solve_widening_step`).
+        solver.enable_velocity_limits(True)
+        for name in robot.joint_names():
+            if name.startswith(FIXED_JOINT_PREFIXES):
+                solver.mask_dof(name)
+        for hold in support:
+            _add_hold_task(solver, hold, "hard", 1.0, 1.0, preferences)
+        for hold in moving:
+            _add_hold_task(solver, hold, "soft", config.moving_position_weight,
+                           config.moving_orientation_weight, preferences)
+        if posture_rad:
+            jt = solver.add_joints_task()
+            jt.set_joints({k: v for k, v in posture_rad.items() if k in kin.q_index})
+            jt.configure("posture", "soft", config.posture_weight)
+        if torso_R is not None:
+            # Torso and pelvis both face the ladder: otherwise waist and hip yaws trade off
+            # freely and neighbouring IK solutions twist the pelvis by tens of degrees.
+            for frame in ("torso_frame", "pelvis"):
+                ot = solver.add_orientation_task(frame, torso_R)
+                ot.configure(f"{frame}_upright", "soft", config.torso_upright_weight)
+        if pelvis_target_m is not None and pelvis_weight > 0:
+            pt = solver.add_position_task("pelvis", np.asarray(pelvis_target_m, dtype=float))
+            pt.configure("pelvis", "soft", pelvis_weight)
+        if com_polygon_cw is not None:
+            cc = solver.add_com_polygon_constraint(np.asarray(com_polygon_cw, dtype=float),
+                                                   config.com_margin_m)
+            # Soft: a hard polygon is infeasible for a start outside it within one bounded
+            # step. Stability is verified on the result anyway.
+            cc.configure("com_polygon", "soft", config.com_polygon_weight)
+        solver.add_regularization_task(config.regularization)
+        checks = _hold_checks(support, moving, config)
+        it = 0
+        pos_err = ang_err = np.inf
+        for it in range(1, config.max_iterations + 1):
+            robot.update_kinematics()
+            if not _solve_widening_step(solver, config, it):
+                break
+            robot.update_kinematics()
+            pos_err, ang_err, ok = _errors(kin, checks)
+            if ok and it > 2:
+                break
+        final = list(_each_hold_error(kin, checks))
+        converged = bool(np.isfinite(pos_err)) and all(met for *_, met in final)
+        misses = () if converged else tuple(HoldMiss(h.limb, h.target, dp, da)
+                                            for h, dp, da, met in final if not met)
+        return IKResult(kin.q, converged, it, float(pos_err), float(ang_err), misses)
+
+
+@contextmanager
+def _narrowed_limits(kin: HuboKinematics, bounds_rad: dict[str, tuple[float, float]]):
+    """The joints' limits narrowed to ``bounds_rad`` (within their own) while the block
+    runs, then put back."""
+    robot = kin.wrapper
+    lower, upper = robot.model.lowerPositionLimit, robot.model.upperPositionLimit
+    saved = {name: (float(lower[kin.q_index[name]]), float(upper[kin.q_index[name]]))
+             for name in bounds_rad}
     try:
-        for name, (lo, hi) in joint_bounds_rad.items():
+        for name, (lo, hi) in bounds_rad.items():
             robot.set_joint_limits(name, max(lo, saved[name][0]), min(hi, saved[name][1]))
-        return _solve(kin, q_seed, support, moving, posture_rad, torso_R, pelvis_target_m,
-                      pelvis_weight, com_polygon_cw, preferences, config)
+        yield
     finally:
         for name, (lo, hi) in saved.items():
             robot.set_joint_limits(name, lo, hi)
-
-
-def _solve(kin: HuboKinematics, q_seed: np.ndarray, support: tuple[Hold, ...],
-           moving: tuple[Hold, ...], posture_rad, torso_R, pelvis_target_m, pelvis_weight,
-           com_polygon_cw, preferences: bool, config: IKConfig) -> IKResult:
-    """`solve_ik` within the robot's current joint limits."""
-    robot = kin.wrapper
-    kin.set_q(q_seed)
-    solver = robot.make_solver()
-    solver.mask_fbase(False)
-    solver.enable_joint_limits(True)
-    # Bounding each step by the joints' speed limits × dt keeps the linearised hard tasks
-    # valid; unbounded steps from a far soft target made the QP diverge. The bound is
-    # set per step (`_solve_widening_step`).
-    solver.enable_velocity_limits(True)
-    for name in robot.joint_names():
-        if name.startswith(FIXED_JOINT_PREFIXES):
-            solver.mask_dof(name)
-    for hold in support:
-        _add_hold_task(solver, hold, "hard", 1.0, 1.0, preferences)
-    for hold in moving:
-        _add_hold_task(solver, hold, "soft", config.moving_position_weight,
-                       config.moving_orientation_weight, preferences)
-    if posture_rad:
-        jt = solver.add_joints_task()
-        jt.set_joints({k: v for k, v in posture_rad.items() if k in kin.q_index})
-        jt.configure("posture", "soft", config.posture_weight)
-    if torso_R is not None:
-        # Torso and pelvis both face the ladder: otherwise waist and hip yaws trade off
-        # freely and neighbouring IK solutions twist the pelvis by tens of degrees.
-        for frame in ("torso_frame", "pelvis"):
-            ot = solver.add_orientation_task(frame, torso_R)
-            ot.configure(f"{frame}_upright", "soft", config.torso_upright_weight)
-    if pelvis_target_m is not None and pelvis_weight > 0:
-        pt = solver.add_position_task("pelvis", np.asarray(pelvis_target_m, dtype=float))
-        pt.configure("pelvis", "soft", pelvis_weight)
-    if com_polygon_cw is not None:
-        cc = solver.add_com_polygon_constraint(np.asarray(com_polygon_cw, dtype=float),
-                                               config.com_margin_m)
-        # Soft: a hard polygon is infeasible for a start outside it within one bounded
-        # step. Stability is verified on the result anyway.
-        cc.configure("com_polygon", "soft", config.com_polygon_weight)
-    solver.add_regularization_task(config.regularization)
-    checks = _hold_checks(support, moving, config)
-    it = 0
-    pos_err = ang_err = np.inf
-    for it in range(1, config.max_iterations + 1):
-        robot.update_kinematics()
-        if not _solve_widening_step(solver, config, it):
-            break
-        robot.update_kinematics()
-        pos_err, ang_err, ok = _errors(kin, checks)
-        if ok and it > 2:
-            break
-    final = list(_each_hold_error(kin, checks))
-    converged = bool(np.isfinite(pos_err)) and all(met for *_, met in final)
-    misses = () if converged else tuple(HoldMiss(h.limb, h.target, dp, da)
-                                        for h, dp, da, met in final if not met)
-    return IKResult(kin.q, converged, it, float(pos_err), float(ang_err), misses)
 
 
 def _solve_widening_step(solver, config: IKConfig, iteration: int) -> bool:

@@ -17,7 +17,7 @@ from planner.configuration.collision import CollisionModel
 from planner.configuration.ik import HoldMiss, IKResult
 from planner.configuration.kinematics import HuboKinematics
 from planner.contacts import Stance
-from planner.holds import WRIST_PITCH_JOINT
+from planner.holds import WRIST_PITCH_JOINT, wrist_bound_hands
 from planner.statics.arm_capacity import (
     DEFAULT_ARM_STRATEGY,
     balance_stance,
@@ -56,16 +56,6 @@ class Verdict:
         """The verdict on an IK solve that did not converge: the holds it left unmet."""
         return cls(False, f"ik {result!r}", np.nan, np.nan, cause=RejectCause.IK,
                    ik_misses=result.misses)
-
-
-def wrist_bound_hands(stance: Stance) -> tuple[str, ...]:
-    """The hands of ``stance`` that keep their wrists out of the singularity: every hand
-    on its hold while a foot is in the air. With both feet down the legs carry the body
-    and a held wrist may pass zero; the plans do, between the foot steps."""
-    holds = [h.limb for h in stance.holds]
-    if sum(1 for limb in holds if limb.endswith("_foot")) >= 2:
-        return ()
-    return tuple(limb for limb in holds if limb in WRIST_PITCH_JOINT)
 
 
 class FeasibilityChecker:
@@ -166,7 +156,9 @@ class FeasibilityChecker:
         """The first hand in ``stance`` whose wrist pitch is within
         ``held_wrist_margin_rad`` of zero while the stance has fewer than two feet (a
         foot in the air: the grips carry the body with one leg), or None."""
-        return next((limb for limb in wrist_bound_hands(stance)
+        if self.held_wrist_margin_rad <= 0:  # no bound (the default): nothing to look at
+            return None
+        return next((limb for limb in wrist_bound_hands(h.limb for h in stance.holds)
                      if abs(float(q[self.wrist_pitch_index[limb]])) < self.held_wrist_margin_rad),
                     None)
 

@@ -52,7 +52,7 @@ from typing import TYPE_CHECKING, NamedTuple
 import numpy as np
 
 from ladders.contact_model import hand_limits, sole_patch_x
-from planner.holds import WRIST_PITCH_JOINT, foot_patch, half_tread_m
+from planner.holds import WRIST_PITCH_JOINT, foot_patch, half_tread_m, wrist_bound_hands
 from planner.statics.arm_capacity import balance_stance, gripping_sides, gripping_torque_limits
 from robot.errors import InputError
 from robot.plan_sidecar import PlanSidecar, Segment, segment_of_lines
@@ -545,21 +545,20 @@ def _new_results() -> dict[str, CheckResult]:
 
 def check_held_wrists(result: CheckResult, traj_rad: np.ndarray, segments: Sequence[Segment],
                       margin_rad: float) -> None:
-    """While a foot is in the air, a hand holding a rail keeps its wrist pitch at least
+    """While a foot is in the air, a hand on its hold keeps its wrist pitch at least
     ``margin_rad`` from zero, its singularity (the margin the plan was made with,
     `plan-ladder --held-wrist-margin`, and the planner's rule,
-    `planner.configuration.validity.wrist_bound_hands`; a plan made without a margin has
-    nothing to meet). The value is the smallest |pitch| on such a line."""
+    `planner.holds.wrist_bound_hands`; a plan made without a margin has nothing to
+    meet). The value is the smallest |pitch| on such a line."""
     from robot.joints import JOINT_INDEX
 
     result.limit = margin_rad
     worst = None
+    bound_segments = [(seg, wrist_bound_hands(seg.holds)) for seg in segments]
     for limb, joint in WRIST_PITCH_JOINT.items():
         bound = np.zeros(len(traj_rad), dtype=bool)
-        for seg in segments:
-            hold = seg.holds.get(limb)
-            feet = sum(1 for held in seg.holds if held.endswith("_foot"))
-            if hold is not None and hold.hold_target.kind is HoldTargetKind.RAIL and feet < 2:
+        for seg, hands in bound_segments:
+            if limb in hands:
                 bound[seg.first_line - 1:seg.last_line] = True
         if not bound.any():
             continue
